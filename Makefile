@@ -1,0 +1,86 @@
+# One entry point for users and CI. Each target installs what it needs and is
+# idempotent: a second run only rebuilds what changed.
+#   make test   - install, build, run the C++ tests (ctest), the CMake consumer and pytest
+#   make demo   - install and run the main job (lptv demo)
+#   make bench  - install (with SUNDIALS), build and run the benchmarks
+SHELL := /bin/bash
+.DEFAULT_GOAL := test
+VENV ?= .venv
+PY := $(VENV)/bin/python
+PIP := $(VENV)/bin/pip
+CMAKE := $(VENV)/bin/cmake
+JOBS ?= 2
+BUILDROOT ?= build
+BUILD := $(BUILDROOT)/cpp
+PREFIX := $(CURDIR)/$(BUILDROOT)/install
+
+APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2
+APT_BENCH := libsundials-dev
+# Python tools and test dependencies, pinned (the package's own runtime
+# dependencies are in pyproject.toml).
+PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
+	numpy==2.4.6 scipy==1.17.1 pytest==9.2.0 hypothesis==6.170.15 matplotlib==3.11.2 \
+	scikit-sundae==1.2.0
+
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: test demo bench deps deps-bench venv cpp cpp-test consumer python pytest clean
+
+# Installs the Debian packages that are missing (apt-get update only when needed).
+define apt_install
+	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "apt-get install:$$missing"; \
+	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
+	fi
+endef
+
+deps:
+	$(call apt_install,$(APT_TEST))
+
+deps-bench: deps
+	$(call apt_install,$(APT_BENCH))
+
+$(VENV)/.pins: Makefile
+	@test -x $(PY) || python3 -m venv $(VENV)
+	$(PIP) install -q --disable-pip-version-check $(PIP_PINS)
+	@touch $@
+
+venv: $(VENV)/.pins
+
+cpp: deps venv
+	$(CMAKE) -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=ON \
+	  -DCMAKE_INSTALL_PREFIX=$(PREFIX) -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
+	$(CMAKE) --build $(BUILD) -j $(JOBS)
+
+cpp-test: cpp
+	cd $(BUILD) && PATH=$(CURDIR)/$(VENV)/bin:$$PATH ctest --output-on-failure -j $(JOBS)
+
+# Installs the C++ package into build/install and builds a tiny consumer against it.
+consumer: cpp
+	$(CMAKE) --install $(BUILD) >/dev/null
+	$(CMAKE) -S tests/cmake_consumer -B $(BUILDROOT)/consumer -G Ninja -DCMAKE_PREFIX_PATH=$(PREFIX) \
+	  -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
+	$(CMAKE) --build $(BUILDROOT)/consumer
+	./$(BUILDROOT)/consumer/lptv_consumer
+
+python: deps venv
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH $(PIP) install -q --disable-pip-version-check --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py .
+
+pytest: python
+	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
+
+test: cpp-test consumer pytest
+
+demo: python
+	$(VENV)/bin/lptv demo
+
+bench: deps-bench python
+	$(CMAKE) -S . -B $(BUILDROOT)/bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=OFF \
+	  -DLPTV_BUILD_BENCH=ON -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
+	$(CMAKE) --build $(BUILDROOT)/bench -j $(JOBS)
+	$(MAKE) --no-print-directory -C . bench-run
+
+clean:
+	rm -rf $(BUILDROOT)

@@ -1,0 +1,85 @@
+// The frequency-domain simulator (METHOD.md section 3): the steady-state output
+// spectrum Y = A^-1 B U of an LPTV model from one sparse factorisation of the band
+// matrix A.
+#pragma once
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lptv/model.hpp"
+#include "lptv/sparse_lu.hpp"
+
+namespace lptv {
+
+using SpMat = Eigen::SparseMatrix<cd, Eigen::ColMajor, int>;
+
+// The frequency grid of a model's band system.
+//  - continuous time: lines -L..L, matrix index i <-> line i - L;
+//  - discrete time: the circular grid of N = samples_per_period() lines, index i <-> line i
+//    (line i and i - N are the same).
+struct Grid {
+  bool circular = false;
+  int L = 0;  // continuous time: highest line; discrete time: unused
+  int N = 0;  // number of lines in the system (2L+1, or samples per period)
+  int line_of(int index) const { return circular ? index : index - L; }
+  // The index of line l (wrapped on the circular grid); -1 when outside -L..L.
+  int index_of(int line) const;
+};
+
+Grid make_grid(const Model& m, int L);
+
+// (j w_l)^n in continuous time, z_l^n = exp(j w_l ts n) in discrete time, for line l.
+cd line_power(const Model& m, const Grid& g, int line, int n);
+
+// A_{l,i} = sum_n a_{n,l-i} (j w_i)^n (METHOD.md eq. 5), B likewise with b.
+SpMat build_A(const Model& m, const Grid& g);
+SpMat build_B(const Model& m, const Grid& g);
+
+// One factorisation of A on a fixed grid, reused for any number of inputs.
+class Fds {
+ public:
+  // Continuous time: grid -L..L (L >= 0). Discrete time: L is ignored (the grid is
+  // the model's circular one). Throws NumericalError when A is singular.
+  Fds(const Model& m, int L, Solver solver = Solver::Auto);
+  const Grid& grid() const { return grid_; }
+  Solver solver() const { return lu_->solver(); }
+  double rcond() const { return lu_->rcond(); }
+  // Full-grid input spectra (grid.N rows, any number of columns) -> output spectra.
+  Eigen::MatrixXcd solve_full(const Eigen::MatrixXcd& U) const;
+  // Columns of the harmonic transfer function G = A^-1 B for the given input lines.
+  Eigen::MatrixXcd htf_columns(const std::vector<int>& input_lines) const;
+
+ private:
+  Grid grid_;
+  SpMat B_;
+  std::unique_ptr<SparseLU> lu_;
+};
+
+struct SimulateOptions {
+  Solver solver = Solver::Auto;
+  // Continuous time: highest output line wanted (-1: the highest input line).
+  int lines_out = -1;
+  // Continuous time: fixed guard lines beyond the band (-1: adaptive, see tol).
+  int guard = -1;
+  // Adaptive guard: grow until the wanted lines change by less than tol relative
+  // to the largest output line.
+  double tol = 1e-13;
+  int max_guard = -1;  // -1: max(1024, 4 * band)
+};
+
+struct SimulateResult {
+  Eigen::MatrixXcd Y;            // one-sided output spectra, lines 0..lines_out
+  int guard = 0;                 // guard lines used (continuous time)
+  double truncation_error = 0;   // estimated relative error from the truncation
+  bool converged = true;         // adaptive guard reached tol
+  Solver solver = Solver::Auto;  // backend actually used
+};
+
+// U: one-sided spectra on lines 0..Lu (rows), one column per input; U(0) and, in
+// discrete time with even N, U(N/2) must be real. X_l = fft(x)[l] / N.
+SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U,
+                        const SimulateOptions& opt = SimulateOptions());
+
+}  // namespace lptv

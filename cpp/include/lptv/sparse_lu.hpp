@@ -1,0 +1,44 @@
+// Sparse LU of a complex square matrix through SuiteSparse: KLU directly (it exposes
+// the singular column and a pivot-based condition estimate) or UMFPACK through
+// Eigen's UmfPackSupport module. One factorisation, many right-hand sides.
+#pragma once
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <complex>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace lptv {
+
+enum class Solver { Auto, KLU, UMFPACK };
+
+// "klu" / "umfpack" / "auto"; throws std::invalid_argument on anything else.
+Solver solver_from_string(const std::string& name);
+std::string solver_name(Solver s);
+// The backend Auto resolves to (see bench/RESULTS.md for the measurement behind it).
+Solver default_solver();
+
+class SparseLU {
+ public:
+  using SpMat = Eigen::SparseMatrix<std::complex<double>, Eigen::ColMajor, int>;
+  // Factorises A. Throws NumericalError when A is singular (naming the column as
+  // index_label(col)) or numerically singular (reciprocal pivot ratio below 1e-15).
+  SparseLU(const SpMat& A, Solver solver, const std::function<std::string(int)>& index_label);
+  ~SparseLU();
+  SparseLU(const SparseLU&) = delete;
+  SparseLU& operator=(const SparseLU&) = delete;
+
+  Eigen::MatrixXcd solve(const Eigen::MatrixXcd& rhs) const;
+  Solver solver() const { return solver_; }
+  // Crude reciprocal condition estimate min|U_kk| / max|U_kk|.
+  double rcond() const { return rcond_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Solver solver_;
+  double rcond_ = 0.0;
+};
+
+}  // namespace lptv

@@ -1,0 +1,225 @@
+#include "lptv/fds.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "lptv/errors.hpp"
+
+namespace lptv {
+
+int Grid::index_of(int line) const {
+  if (circular) {
+    int i = line % N;
+    return i < 0 ? i + N : i;
+  }
+  return (line < -L || line > L) ? -1 : line + L;
+}
+
+Grid make_grid(const Model& m, int L) {
+  Grid g;
+  if (m.discrete()) {
+    g.circular = true;
+    g.N = m.samples_per_period();
+    g.L = g.N / 2;
+  } else {
+    if (L < 0) throw std::invalid_argument("L must be >= 0, got " + std::to_string(L));
+    g.L = L;
+    g.N = 2 * L + 1;
+  }
+  return g;
+}
+
+cd line_power(const Model& m, const Grid& g, int line, int n) {
+  const double w = m.w0() * line;
+  const cd s = m.discrete() ? std::polar(1.0, w * m.ts()) : cd(0.0, w);
+  (void)g;
+  cd p(1.0, 0.0);
+  for (int i = 0; i < n; ++i) p *= s;
+  return p;
+}
+
+namespace {
+
+// Entries sum_n c_{n,l-i} s_i^n for |l-i| <= K; on the circular grid the band wraps.
+SpMat build_band(const Model& m, const Grid& g, const Eigen::MatrixXcd& c) {
+  const int order = static_cast<int>(c.rows()) - 1;
+  const int K = static_cast<int>(c.cols() - 1) / 2;
+  std::vector<Eigen::Triplet<cd, int>> trip;
+  trip.reserve(static_cast<size_t>(g.N) * (2 * K + 1));
+  std::vector<cd> pw(order + 1);
+  for (int col = 0; col < g.N; ++col) {
+    const int i = g.line_of(col);
+    for (int n = 0; n <= order; ++n) pw[n] = line_power(m, g, i, n);
+    for (int k = -K; k <= K; ++k) {
+      const int row = g.index_of(i + k);
+      if (row < 0) continue;
+      cd v(0.0, 0.0);
+      for (int n = 0; n <= order; ++n) v += c(n, K + k) * pw[n];
+      if (v != cd(0.0, 0.0)) trip.emplace_back(row, col, v);
+    }
+  }
+  SpMat M(g.N, g.N);
+  M.setFromTriplets(trip.begin(), trip.end());  // sums duplicates: none when 2K+1 <= N
+  M.makeCompressed();
+  return M;
+}
+
+}  // namespace
+
+SpMat build_A(const Model& m, const Grid& g) { return build_band(m, g, m.a()); }
+SpMat build_B(const Model& m, const Grid& g) { return build_band(m, g, m.b()); }
+
+Fds::Fds(const Model& m, int L, Solver solver) : grid_(make_grid(m, L)), B_(build_B(m, grid_)) {
+  const SpMat A = build_A(m, grid_);
+  const Grid g = grid_;
+  lu_ = std::make_unique<SparseLU>(A, solver, [g](int col) {
+    return "line " + std::to_string(g.line_of(col));
+  });
+}
+
+Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
+  if (U.rows() != grid_.N) {
+    throw std::invalid_argument("U must have " + std::to_string(grid_.N) +
+                                " rows (the grid), got " + std::to_string(U.rows()));
+  }
+  return lu_->solve(B_ * U);
+}
+
+Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {
+  Eigen::MatrixXcd rhs = Eigen::MatrixXcd::Zero(grid_.N, static_cast<Eigen::Index>(input_lines.size()));
+  for (size_t j = 0; j < input_lines.size(); ++j) {
+    const int idx = grid_.index_of(input_lines[j]);
+    if (idx < 0) {
+      throw std::invalid_argument("lines: input line " + std::to_string(input_lines[j]) +
+                                  " is outside the grid -" + std::to_string(grid_.L) + ".." +
+                                  std::to_string(grid_.L));
+    }
+    rhs(idx, static_cast<Eigen::Index>(j)) = 1.0;
+  }
+  return lu_->solve(B_ * rhs);
+}
+
+namespace {
+
+void check_input(const Eigen::MatrixXcd& U) {
+  if (U.rows() < 1 || U.cols() < 1) throw std::invalid_argument("U must not be empty");
+  if (!U.allFinite()) throw std::invalid_argument("U contains NaN or inf");
+  const double scale = std::max(U.cwiseAbs().maxCoeff(), 1e-300);
+  for (Eigen::Index j = 0; j < U.cols(); ++j) {
+    if (std::abs(U(0, j).imag()) > 1e-12 * scale) {
+      throw std::invalid_argument(
+          "U: line 0 (DC) must be real for a real input signal, column " + std::to_string(j) +
+          " has imaginary part " + std::to_string(U(0, j).imag()));
+    }
+  }
+}
+
+// One-sided spectra on lines 0..Lu -> full grid (conjugate lines filled in).
+Eigen::MatrixXcd to_full(const Grid& g, const Eigen::MatrixXcd& U) {
+  Eigen::MatrixXcd F = Eigen::MatrixXcd::Zero(g.N, U.cols());
+  for (Eigen::Index l = 0; l < U.rows(); ++l) {
+    F.row(g.index_of(static_cast<int>(l))) = U.row(l);
+    if (l > 0) F.row(g.index_of(-static_cast<int>(l))) += U.row(l).conjugate();
+  }
+  if (g.circular && g.N % 2 == 0 && U.rows() > g.N / 2) {
+    // Line N/2 is its own conjugate: the two contributions above add to 2 Re U.
+    F.row(g.N / 2) = U.row(g.N / 2).real().cast<cd>();
+  }
+  if (g.circular && U.rows() > 0) F.row(0) = U.row(0).real().cast<cd>();
+  return F;
+}
+
+Eigen::MatrixXcd to_onesided(const Grid& g, const Eigen::MatrixXcd& Y, int lines_out) {
+  Eigen::MatrixXcd out(lines_out + 1, Y.cols());
+  for (int l = 0; l <= lines_out; ++l) out.row(l) = Y.row(g.index_of(l));
+  return out;
+}
+
+}  // namespace
+
+SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const SimulateOptions& opt) {
+  check_input(U);
+  SimulateResult res;
+  const int Lu = static_cast<int>(U.rows()) - 1;
+  if (m.discrete()) {
+    const Grid g = make_grid(m, 0);
+    if (Lu > g.N / 2) {
+      throw std::invalid_argument("U has lines 0.." + std::to_string(Lu) +
+                                  " but the discrete-time grid of " + std::to_string(g.N) +
+                                  " samples per period has one-sided lines 0.." +
+                                  std::to_string(g.N / 2));
+    }
+    if (g.N % 2 == 0 && Lu == g.N / 2) {
+      const double scale = std::max(U.cwiseAbs().maxCoeff(), 1e-300);
+      if (U.row(Lu).imag().cwiseAbs().maxCoeff() > 1e-12 * scale) {
+        throw std::invalid_argument("U: the Nyquist line N/2 must be real for a real input signal");
+      }
+    }
+    int lines_out = opt.lines_out < 0 ? Lu : opt.lines_out;
+    if (lines_out > g.N / 2) {
+      throw std::invalid_argument("lines_out must be <= N/2 = " + std::to_string(g.N / 2));
+    }
+    Fds fds(m, 0, opt.solver);
+    res.Y = to_onesided(g, fds.solve_full(to_full(g, U)), lines_out);
+    res.solver = fds.solver();
+    return res;
+  }
+
+  const int lines_out = opt.lines_out < 0 ? Lu : opt.lines_out;
+  const int band = std::max(Lu, lines_out);
+  const int K = std::max(1, m.kmax());
+  auto run = [&](int guard) {
+    Fds fds(m, band + guard, opt.solver);
+    res.solver = fds.solver();
+    return to_onesided(fds.grid(), fds.solve_full(to_full(fds.grid(), U)), lines_out);
+  };
+  if (m.kmax() == 0) {
+    // LTI: A is diagonal, lines do not couple, no truncation error.
+    res.Y = run(0);
+    return res;
+  }
+  if (opt.guard >= 0) {
+    // Fixed guard: the lines beyond the grid are taken as zero; the size of the
+    // outermost K computed lines tells how wrong that is.
+    Fds fds(m, band + opt.guard, opt.solver);
+    const Eigen::MatrixXcd full = fds.solve_full(to_full(fds.grid(), U));
+    res.solver = fds.solver();
+    res.guard = opt.guard;
+    res.Y = to_onesided(fds.grid(), full, lines_out);
+    const double peak = std::max(full.cwiseAbs().maxCoeff(), 1e-300);
+    const int L = fds.grid().L;
+    double edge = 0;
+    for (int l = std::max(0, L - K + 1); l <= L; ++l) {
+      edge = std::max(edge, full.row(fds.grid().index_of(l)).cwiseAbs().maxCoeff());
+    }
+    res.truncation_error = edge / peak;
+    res.converged = res.truncation_error <= opt.tol;
+    return res;
+  }
+  const int max_guard = opt.max_guard >= 0 ? opt.max_guard : std::max(1024, 4 * band);
+  int guard = std::max(16, 4 * K);
+  Eigen::MatrixXcd prev = run(guard);
+  while (true) {
+    const int next = 2 * guard;
+    Eigen::MatrixXcd cur = run(next);
+    const double peak = std::max(cur.cwiseAbs().maxCoeff(), 1e-300);
+    const double diff = (cur - prev).cwiseAbs().maxCoeff() / peak;
+    res.Y = cur;
+    res.guard = next;
+    res.truncation_error = diff;
+    if (diff <= opt.tol) {
+      res.converged = true;
+      return res;
+    }
+    if (next >= max_guard) {
+      res.converged = false;
+      return res;
+    }
+    prev = std::move(cur);
+    guard = next;
+  }
+}
+
+}  // namespace lptv

@@ -1,0 +1,19 @@
+#include "pybind11.hpp"
+
+#include "lptv/errors.hpp"
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "lptv compiled core: model, multisines, frequency-domain simulator";
+  // std::invalid_argument becomes ValueError by pybind11's default translation.
+  static py::exception<lptv::NumericalError> numerical_error(m, "NumericalError", PyExc_ArithmeticError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const lptv::NumericalError& e) {
+      py::set_error(numerical_error, e.what());
+    }
+  });
+  bind_model(m);
+  bind_multisine(m);
+  bind_fds(m);
+}

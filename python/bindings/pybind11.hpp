@@ -1,0 +1,14 @@
+// The one pybind11 include of the bindings.
+#pragma once
+#include <pybind11/complex.h>
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+namespace py = pybind11;
+using namespace pybind11::literals;
+
+void bind_model(py::module_& m);
+void bind_multisine(py::module_& m);
+void bind_fds(py::module_& m);

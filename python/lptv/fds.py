@@ -1,0 +1,132 @@
+"""The frequency-domain simulator (FDS, METHOD.md section 3)."""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Optional, Sequence
+
+import numpy as np
+
+from . import _core
+from ._validate import as_spectrum
+from .model import Model
+
+
+class TruncationWarning(UserWarning):
+    """The adaptive guard did not bring the truncation error below the tolerance."""
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Output of :func:`simulate` with ``full_output=True``."""
+
+    Y: np.ndarray
+    """One-sided output spectra on lines 0..lines_out."""
+    guard: int
+    """Guard lines used beyond the band (continuous time)."""
+    truncation_error: float
+    """Estimated error from dropping lines beyond the grid, relative to the largest output line."""
+    converged: bool
+    """Whether the truncation error met ``tol``."""
+    solver: str
+    """Sparse LU backend used ('klu' or 'umfpack')."""
+
+
+def _check_model(model, name="model"):
+    if not isinstance(model, Model):
+        raise ValueError(f"{name} must be an lptv.Model, got {type(model).__name__}")
+    return model
+
+
+def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optional[int] = None,
+             tol: float = 1e-13, max_guard: Optional[int] = None, solver: str = "auto",
+             full_output: bool = False):
+    """Steady-state output spectrum of ``model`` for the input spectrum ``U``.
+
+    Solves the band system ``A Y = B U`` (METHOD.md eq. 5) with one sparse LU.
+
+    Parameters
+    ----------
+    model : lptv.Model
+    U : array_like, shape (L+1,) or (L+1, n_inputs)
+        One-sided Fourier coefficients on lines 0..L: ``U[l] = fft(u)[l] / N`` for N samples
+        of one period, so a cosine of amplitude A and phase phi on line l has
+        ``U[l] = A/2 exp(j phi)``. ``U[0]`` must be real. Several columns share one factorisation.
+    lines_out : int, optional
+        Highest output line to return (default L).
+    guard : int, optional
+        Continuous time: a fixed number of guard lines beyond the band. By default the guard
+        grows until the returned lines change by less than ``tol`` relative to the largest.
+    tol : float
+        Relative truncation tolerance of the adaptive guard.
+    solver : {'auto', 'klu', 'umfpack'}
+    full_output : bool
+        Return a :class:`SimulationResult` instead of ``Y``.
+
+    Returns
+    -------
+    Y : ndarray, same shape as U (rows up to ``lines_out``)
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> m = lptv.Model([[1.0], [1.0]], [[1.0]], w0=1.0)      # 1 / (s + 1)
+    >>> U = np.zeros(3, complex); U[1] = 0.5                   # cos(t)
+    >>> np.round(lptv.simulate(m, U)[1], 6)                    # 0.5 / (1j + 1)
+    np.complex128(0.25-0.25j)
+    """
+    _check_model(model)
+    Ua, was_1d = as_spectrum(U, "U")
+    if lines_out is not None and (int(lines_out) != lines_out or lines_out < 0):
+        raise ValueError(f"lines_out must be a non-negative integer, got {lines_out!r}")
+    if guard is not None and (int(guard) != guard or guard < 0):
+        raise ValueError(f"guard must be a non-negative integer, got {guard!r}")
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be positive, got {tol!r}")
+    r = _core.simulate(model._cpp, Ua, solver=solver,
+                       lines_out=-1 if lines_out is None else int(lines_out),
+                       guard=-1 if guard is None else int(guard), tol=float(tol),
+                       max_guard=-1 if max_guard is None else int(max_guard))
+    Y = np.asarray(r["Y"])
+    if was_1d:
+        Y = Y[:, 0]
+    if not r["converged"] and not model.discrete and not model.is_lti:
+        warnings.warn(
+            f"FDS truncation error {r['truncation_error']:.2e} is above tol={tol:g} "
+            f"with {r['guard']} guard lines; pass a larger max_guard or guard",
+            TruncationWarning, stacklevel=2)
+    if full_output:
+        return SimulationResult(Y=Y, guard=r["guard"], truncation_error=r["truncation_error"],
+                                converged=r["converged"], solver=r["solver"])
+    return Y
+
+
+def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str = "auto"):
+    """Columns of the truncated harmonic transfer function G = A^-1 B.
+
+    Parameters
+    ----------
+    model : lptv.Model
+    L : int
+        Continuous time: the grid is lines -L..L (ignored in discrete time, where the grid is
+        the model's N lines 0..N-1).
+    lines : sequence of int, optional
+        Input lines whose columns to return (default: all).
+
+    Returns
+    -------
+    G : ndarray (grid size, len(lines)); row i is output line i - L (continuous) or i (discrete).
+    """
+    _check_model(model)
+    if int(L) != L or L < 0:
+        raise ValueError(f"L must be a non-negative integer, got {L!r}")
+    n = model.samples_per_period if model.discrete else 2 * int(L) + 1
+    if lines is None:
+        lines = range(n) if model.discrete else range(-int(L), int(L) + 1)
+    return np.asarray(_core.htf(model._cpp, int(L), [int(x) for x in lines], solver))
+
+
+def band_matrices(model: Model, L: int = 0):
+    """The sparse band matrices (A, B) of METHOD.md eq. 5 as scipy.sparse CSC matrices."""
+    _check_model(model)
+    return _core.band_matrix(model._cpp, int(L), True), _core.band_matrix(model._cpp, int(L), False)
