@@ -16,4 +16,5 @@ PYBIND11_MODULE(_core, m) {
   bind_model(m);
   bind_multisine(m);
   bind_fds(m);
+  bind_identify(m);
 }

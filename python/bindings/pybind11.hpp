@@ -12,3 +12,4 @@ using namespace pybind11::literals;
 void bind_model(py::module_& m);
 void bind_multisine(py::module_& m);
 void bind_fds(py::module_& m);
+void bind_identify(py::module_& m);

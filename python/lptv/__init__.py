@@ -5,17 +5,23 @@ The public API:
 - :class:`Model` - the LPTV model (and LTI as its special case), JSON save/load;
 - :func:`multisine`, :func:`spectrum`, :func:`time_signal` - excitation and spectra;
 - :func:`simulate`, :func:`htf`, :func:`band_matrices` - the frequency-domain simulator;
+- :class:`FrequencyData`, :func:`identify` - noise model and estimators (LS, TLS, GTLS, WGTLS);
+- :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
 - :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
 """
 from ._core import NumericalError
 from .fds import SimulationResult, TruncationWarning, band_matrices, htf, simulate
+from .data import FrequencyData
+from .identify import IdentifiabilityWarning, IdentificationResult, identify
 from .model import Model
+from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import Multisine, multisine, spectrum, time_signal
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
-    "band_matrices", "htf", "multisine", "simulate", "spectrum", "time_signal",
+    "FrequencyData", "IdentifiabilityWarning", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
+    "band_matrices", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
+    "identify", "normalized_residue", "multisine", "simulate", "spectrum", "time_signal",
 ]

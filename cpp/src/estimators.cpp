@@ -1,0 +1,239 @@
+#include "lptv/estimators.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include "lptv/errors.hpp"
+#include "lptv/gsvd.hpp"
+
+namespace lptv {
+
+Method method_from_string(const std::string& name) {
+  if (name == "ls") return Method::LS;
+  if (name == "tls") return Method::TLS;
+  if (name == "gtls") return Method::GTLS;
+  if (name == "wgtls") return Method::WGTLS;
+  throw std::invalid_argument("method must be 'ls', 'tls', 'gtls' or 'wgtls', got '" + name + "'");
+}
+
+std::string method_name(Method m) {
+  switch (m) {
+    case Method::LS: return "ls";
+    case Method::TLS: return "tls";
+    case Method::GTLS: return "gtls";
+    default: return "wgtls";
+  }
+}
+
+namespace {
+
+// Nonzeros of Text: theta_p contributes Text(p, c) to xi column c.
+struct TextEntry {
+  int p, c;
+  cd v;
+};
+
+std::vector<TextEntry> text_entries(const Parametrisation& p) {
+  std::vector<TextEntry> out;
+  const Eigen::MatrixXcd& T = p.Text();
+  for (int c = 0; c < T.cols(); ++c)
+    for (int q = 0; q < T.rows(); ++q)
+      if (T(q, c) != cd(0.0, 0.0)) out.push_back({q, c, T(q, c)});
+  return out;
+}
+
+// QR of rows [begin, end) into an n x n upper-triangular R, block by block.
+Eigen::MatrixXd r_factor_range(const FrequencyData& d, const Parametrisation& p,
+                               const std::vector<int>& rows, const Eigen::VectorXd& weights,
+                               size_t begin, size_t end) {
+  const int n = p.n_xi();
+  const Structure& s = p.structure();
+  const auto entries = text_entries(p);
+  constexpr int kBlock = 512;  // complex rows per block: 2 * 512 real rows
+  Eigen::MatrixXd M(n + 2 * kBlock, n);
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
+  std::vector<cd> jrow(p.n_theta());
+  Eigen::VectorXcd xrow(n);
+  for (size_t b0 = begin; b0 < end; b0 += kBlock) {
+    const int nb = static_cast<int>(std::min<size_t>(kBlock, end - b0));
+    M.topRows(n) = R;
+    for (int r = 0; r < nb; ++r) {
+      const int l = rows[b0 + r];
+      for (int q = 0; q < p.n_theta(); ++q) {
+        const Param& pr = p.params()[q];
+        const int i = l - pr.k;
+        const cd X = pr.is_a ? (i >= 0 ? d.Y[i] : std::conj(d.Y[-i]))
+                             : -(i >= 0 ? d.U[i] : std::conj(d.U[-i]));
+        jrow[q] = line_power(s, i, pr.order) * X;
+      }
+      xrow.setZero();
+      for (const auto& e : entries) xrow[e.c] += jrow[e.p] * e.v;
+      const double sw = weights.size() ? std::sqrt(weights[b0 + r]) : 1.0;
+      M.row(n + 2 * r) = sw * xrow.real().transpose();
+      M.row(n + 2 * r + 1) = sw * xrow.imag().transpose();
+    }
+    const int m = n + 2 * nb;
+    Eigen::Ref<Eigen::MatrixXd> Mr = M.topRows(m);
+    Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(Mr);  // in place
+    R = M.topLeftCorner(n, n).triangularView<Eigen::Upper>();
+  }
+  return R;
+}
+
+}  // namespace
+
+Eigen::MatrixXd weighted_r_factor(const FrequencyData& d, const Parametrisation& p,
+                                  const std::vector<int>& rows, const Eigen::VectorXd& weights) {
+  if (weights.size() && weights.size() != static_cast<Eigen::Index>(rows.size())) {
+    throw std::invalid_argument("weights must have one entry per row");
+  }
+  const int n = p.n_xi();
+  // Two halves on two threads when there is enough work; their R factors are merged
+  // by one more small QR.
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  if (hw < 2 || rows.size() < 20000) return r_factor_range(d, p, rows, weights, 0, rows.size());
+  const size_t mid = rows.size() / 2;
+  Eigen::MatrixXd R1;
+  std::thread t([&] { R1 = r_factor_range(d, p, rows, weights, 0, mid); });
+  Eigen::MatrixXd R2 = r_factor_range(d, p, rows, weights, mid, rows.size());
+  t.join();
+  Eigen::MatrixXd M(2 * n, n);
+  M << R1, R2;
+  Eigen::Ref<Eigen::MatrixXd> Mr = M;
+  Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(Mr);
+  return M.topRows(n).triangularView<Eigen::Upper>();
+}
+
+Eigen::MatrixXd real_column_covariance(const FrequencyData& d, const Parametrisation& p,
+                                       const std::vector<int>& rows, const Eigen::VectorXd& weights) {
+  const Eigen::MatrixXcd C = column_covariance(d, p, rows, weights);
+  const Eigen::MatrixXcd& T = p.Text();
+  Eigen::MatrixXd CJ = (T.adjoint() * C * T).real();
+  return 0.5 * (CJ + CJ.transpose());  // exact symmetry against rounding
+}
+
+GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
+  const Eigen::Index n = R.cols();
+  Eigen::VectorXd scale(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double c = R.col(j).norm();
+    scale[j] = c > 0 ? 1.0 / c : 1.0;
+  }
+  const Eigen::MatrixXd Rs = R * scale.asDiagonal();
+  const Eigen::MatrixXd Cs = scale.asDiagonal() * CJ * scale.asDiagonal();
+  // CJ^{1/2} as a square factor S with S^T S = Cs; negative rounding-level
+  // eigenvalues of the (positive semidefinite) covariance are set to zero.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Cs);
+  if (es.info() != Eigen::Success) throw NumericalError("eigendecomposition of the column covariance failed");
+  const Eigen::VectorXd lam = es.eigenvalues().cwiseMax(0.0);
+  const Eigen::MatrixXd S = lam.cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
+  const GeneralizedPairs g = gsvd_pairs(Rs, S);
+  if (g.values.size() == 0) throw NumericalError("GSVD: no finite generalised singular value");
+  GtlsSolve out;
+  out.x = scale.asDiagonal() * g.vectors.col(0);
+  out.values = g.values;
+  return out;
+}
+
+namespace {
+
+struct Solved {
+  Eigen::VectorXd x;
+  Eigen::VectorXd values;
+  double cost;
+};
+
+Solved solve_tls(const Eigen::MatrixXd& R) {
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(R, Eigen::ComputeFullV);
+  const Eigen::Index n = R.cols();
+  Solved s;
+  s.x = svd.matrixV().col(n - 1);
+  s.values = svd.singularValues().reverse();
+  s.cost = s.values[0] * s.values[0];
+  return s;
+}
+
+Solved solve_ls(const Eigen::MatrixXd& R, int norm_index) {
+  const Eigen::Index n = R.cols();
+  Eigen::MatrixXd Rr(n, n - 1);
+  for (Eigen::Index j = 0, c = 0; j < n; ++j)
+    if (j != norm_index) Rr.col(c++) = R.col(j);
+  const Eigen::VectorXd z = Rr.colPivHouseholderQr().solve(-R.col(norm_index));
+  Solved s;
+  s.x.resize(n);
+  for (Eigen::Index j = 0, c = 0; j < n; ++j) s.x[j] = j == norm_index ? 1.0 : z[c++];
+  s.cost = (R * s.x).squaredNorm();
+  return s;
+}
+
+Solved solve_gtls(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
+  GtlsSolve g = gtls_from_r(R, CJ);
+  return {g.x, g.values, g.values[0] * g.values[0]};
+}
+
+}  // namespace
+
+EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                        const EstimateOptions& opt) {
+  d.validate();
+  check_rows(p, rows, d.max_line());
+  if (!(opt.tol > 0)) throw std::invalid_argument("tol must be > 0");
+  if (opt.max_iter < 0) throw std::invalid_argument("max_iter must be >= 0");
+  EstimateResult res;
+  const Eigen::VectorXd none;
+  auto finish = [&](const Solved& s) {
+    res.theta = p.theta_from_xi(s.x);
+    res.eta = p.eta_from_xi(s.x);
+    res.singular_values = s.values;
+    res.cost = s.cost;
+  };
+  const Eigen::MatrixXd R = weighted_r_factor(d, p, rows, none);
+  if (opt.method == Method::LS) {
+    finish(solve_ls(R, p.norm_index()));
+    return res;
+  }
+  if (opt.method == Method::TLS) {
+    finish(solve_tls(R));
+    return res;
+  }
+  const Eigen::MatrixXd CJ = real_column_covariance(d, p, rows, Eigen::VectorXd::Ones(rows.size()));
+  if (CJ.cwiseAbs().maxCoeff() == 0.0) {
+    // No noise anywhere: the noise-weighted problems have no weight to apply and
+    // reduce to TLS, which is exact on noise-free data.
+    res.noise_free = true;
+    finish(solve_tls(R));
+    return res;
+  }
+  finish(solve_gtls(R, CJ));
+  if (opt.method == Method::GTLS) return res;
+
+  res.converged = false;
+  for (int it = 1; it <= opt.max_iter; ++it) {
+    Eigen::VectorXd v = residue_variance(d, p, rows, res.theta);
+    const double vmax = v.maxCoeff();
+    if (!(vmax > 0) || !v.allFinite()) {
+      throw NumericalError("WGTLS: the residue variance is not positive at iteration " +
+                           std::to_string(it));
+    }
+    // Rows whose residue carries (numerically) no noise get the largest finite weight
+    // rather than an infinite one.
+    const double floor = vmax * 1e-14;
+    const Eigen::VectorXd w = v.cwiseMax(floor).cwiseInverse();
+    const Eigen::MatrixXd Rw = weighted_r_factor(d, p, rows, w);
+    const Eigen::MatrixXd CJw = real_column_covariance(d, p, rows, w);
+    const Eigen::VectorXcd prev = res.theta;
+    finish(solve_gtls(Rw, CJw));
+    res.iterations = it;
+    res.cost_history.push_back(res.cost);
+    const double change = (res.theta - prev).norm() / res.theta.norm();
+    if (change < opt.tol) {
+      res.converged = true;
+      break;
+    }
+  }
+  return res;
+}
+
+}  // namespace lptv

@@ -1,0 +1,66 @@
+#include "lptv/noise.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "lptv/multisine.hpp"
+
+namespace lptv {
+
+void FrequencyData::validate() const {
+  const Eigen::Index n = U.size();
+  if (n < 1) throw std::invalid_argument("U must not be empty");
+  auto same = [n](Eigen::Index m, const char* name) {
+    if (m != n) {
+      throw std::invalid_argument(std::string(name) + " must have " + std::to_string(n) +
+                                  " lines like U, got " + std::to_string(m));
+    }
+  };
+  same(Y.size(), "Y");
+  same(varU.size(), "varU");
+  same(varY.size(), "varY");
+  same(covYU.size(), "covYU");
+  if (!U.allFinite()) throw std::invalid_argument("U contains NaN or inf");
+  if (!Y.allFinite()) throw std::invalid_argument("Y contains NaN or inf");
+  if (!varU.allFinite() || (varU.array() < 0).any())
+    throw std::invalid_argument("varU must be finite and >= 0");
+  if (!varY.allFinite() || (varY.array() < 0).any())
+    throw std::invalid_argument("varY must be finite and >= 0");
+  if (!covYU.allFinite()) throw std::invalid_argument("covYU contains NaN or inf");
+}
+
+FrequencyData frequency_data_from_periods(const Eigen::MatrixXd& u, const Eigen::MatrixXd& y) {
+  if (u.rows() != y.rows() || u.cols() != y.cols()) {
+    throw std::invalid_argument("u and y must have the same shape (P, N), got (" +
+                                std::to_string(u.rows()) + ", " + std::to_string(u.cols()) +
+                                ") and (" + std::to_string(y.rows()) + ", " +
+                                std::to_string(y.cols()) + ")");
+  }
+  const int P = static_cast<int>(u.rows());
+  if (P < 2) {
+    throw std::invalid_argument("u, y: at least 2 periods are needed for a noise model, got " +
+                                std::to_string(P));
+  }
+  if (u.cols() < 2) throw std::invalid_argument("u, y: a period needs at least 2 samples");
+  if (!u.allFinite()) throw std::invalid_argument("u contains NaN or inf");
+  if (!y.allFinite()) throw std::invalid_argument("y contains NaN or inf");
+  const Eigen::Index nl = u.cols() / 2 + 1;
+  Eigen::MatrixXcd Up(nl, P), Yp(nl, P);
+  for (int p = 0; p < P; ++p) {
+    Up.col(p) = spectrum(u.row(p).transpose());
+    Yp.col(p) = spectrum(y.row(p).transpose());
+  }
+  FrequencyData d;
+  d.periods = P;
+  d.U = Up.rowwise().mean();
+  d.Y = Yp.rowwise().mean();
+  const Eigen::MatrixXcd dU = Up.colwise() - d.U;
+  const Eigen::MatrixXcd dY = Yp.colwise() - d.Y;
+  const double scale = 1.0 / (double(P) * double(P - 1));  // variance of the mean
+  d.varU = dU.cwiseAbs2().rowwise().sum() * scale;
+  d.varY = dY.cwiseAbs2().rowwise().sum() * scale;
+  d.covYU = (dY.array() * dU.conjugate().array()).rowwise().sum().matrix() * scale;
+  return d;
+}
+
+}  // namespace lptv

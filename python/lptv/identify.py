@@ -1,0 +1,242 @@
+"""Identification: LS, TLS, GTLS and weighted GTLS (METHOD.md sections 5-7)."""
+from __future__ import annotations
+
+import re
+import warnings
+from dataclasses import dataclass, field
+from typing import Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _core
+from .data import FrequencyData
+from .model import Model
+from .validation import expected_fraction_above_0db, normalized_residue
+
+METHODS = ("ls", "tls", "gtls", "wgtls")
+
+
+class IdentifiabilityWarning(UserWarning):
+    """The two smallest generalised singular values are close: the model is nearly unidentifiable."""
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """What :func:`identify` returns."""
+
+    model: Model
+    """The estimate, normalised so that a_{na,0} = 1 (or scaled by the known coefficients)."""
+    method: str
+    lines: np.ndarray
+    """Rows (lines) of the fit."""
+    theta: np.ndarray
+    """All complex parameters: harmonics -K..K of a_0..a_na, then of b_0..b_nb."""
+    eta: np.ndarray
+    """The free real parameters (Re c_0, Re c_1, Im c_1, ... per free coefficient)."""
+    n_free_parameters: int
+    iterations: int
+    """WGTLS: weighted solves after the GTLS start (0 for the other methods)."""
+    converged: bool
+    cost: float
+    """The method's objective at the estimate (WGTLS: the smallest generalised eigenvalue)."""
+    cost_history: np.ndarray
+    singular_values: np.ndarray
+    """Generalised (GTLS, WGTLS) or ordinary (TLS) singular values, ascending; empty for LS."""
+    residue: np.ndarray
+    """e_l = A(theta) Y - B(theta) U on the rows."""
+    residue_variance: np.ndarray
+    """var e_l with the estimate (METHOD.md eq. 15)."""
+    normalized_residue: np.ndarray
+    """|e_l| / sqrt(var e_l)."""
+    fraction_above_0db: float
+    fraction_expected: float
+    fraction_band: Tuple[float, float]
+    """Band around the expected fraction (3 binomial standard deviations)."""
+    noise_free: bool
+    """The data carried no noise, so GTLS/WGTLS reduced to TLS."""
+    warnings: Tuple[str, ...] = field(default_factory=tuple)
+    data: Optional[FrequencyData] = field(default=None, repr=False)
+
+    @property
+    def residue_ok(self) -> bool:
+        """The fraction of normalised residues above 0 dB lies in the predicted band."""
+        lo, hi = self.fraction_band
+        return lo <= self.fraction_above_0db <= hi
+
+    def summary(self) -> str:
+        lo, hi = self.fraction_band
+        verdict = "consistent with the noise" if self.residue_ok else "OUTSIDE the predicted band: model errors?"
+        lines = [
+            f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} lines",
+            f"iterations {self.iterations}, converged {self.converged}, cost {self.cost:.4g}",
+            f"normalised residue above 0 dB: {100 * self.fraction_above_0db:.1f} % "
+            f"(expected {100 * self.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %): {verdict}",
+        ]
+        lines += [f"warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+
+def _counts(k, n, name):
+    if np.ndim(k) == 0:
+        if int(k) != k or k < 0:
+            raise ValueError(f"{name} must be a non-negative integer or one per coefficient, got {k!r}")
+        return [int(k)] * (n + 1)
+    ks = list(k)
+    if len(ks) != n + 1:
+        raise ValueError(f"{name} must give one harmonic count per coefficient ({n + 1}), got {len(ks)}")
+    for v in ks:
+        if int(v) != v or v < 0:
+            raise ValueError(f"{name}: harmonic counts must be non-negative integers, got {ks}")
+    return [int(v) for v in ks]
+
+
+def _known_list(known, ka, kb):
+    if not known:
+        return []
+    if not isinstance(known, Mapping):
+        raise ValueError("known must be a dict like {'a2': 1.5} (coefficient name -> value or Fourier row)")
+    out = []
+    for name, value in known.items():
+        m = re.fullmatch(r"([ab])(\d+)", str(name))
+        if not m:
+            raise ValueError(f"known: {name!r} is not a coefficient name like 'a0' or 'b1'")
+        is_a, order = m.group(1) == "a", int(m.group(2))
+        counts = ka if is_a else kb
+        if order >= len(counts):
+            raise ValueError(f"known: {name} is not a coefficient of the model "
+                             f"({'na' if is_a else 'nb'} = {len(counts) - 1})")
+        K = counts[order]
+        v = np.asarray(value)
+        if v.dtype == object or not np.issubdtype(v.dtype, np.number):
+            raise ValueError(f"known: {name} must be numeric")
+        v = np.atleast_1d(v.astype(complex))
+        if v.ndim != 1 or v.size % 2 != 1:
+            raise ValueError(f"known: {name} must be a scalar or an odd-length Fourier row, got shape {v.shape}")
+        Kv = v.size // 2
+        if Kv > K:
+            raise ValueError(f"known: {name} has {Kv} harmonics but its harmonic count is {K}")
+        row = np.zeros(2 * K + 1, complex)
+        row[K - Kv:K + Kv + 1] = v
+        if not np.all(np.isfinite(row)):
+            raise ValueError(f"known: {name} contains NaN or inf")
+        out.append((is_a, order, row))
+    return out
+
+
+def _rows(lines, par, data):
+    if lines is None:
+        return par.default_rows(data.max_line)
+    try:
+        rows = np.asarray(list(lines) if not isinstance(lines, np.ndarray) else lines)
+    except TypeError:
+        raise ValueError(f"lines must be a sequence of integers, got {lines!r}") from None
+    if rows.ndim != 1 or rows.size == 0:
+        raise ValueError("lines must be a non-empty 1-D sequence of integers")
+    if not np.issubdtype(rows.dtype, np.integer):
+        if np.issubdtype(rows.dtype, np.floating) and np.all(rows == np.round(rows)):
+            rows = rows.astype(int)
+        else:
+            raise ValueError(f"lines must be integers, got dtype {rows.dtype}")
+    return [int(r) for r in rows]
+
+
+def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
+             kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
+             lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
+             max_iter: int = 50) -> IdentificationResult:
+    """Estimate an LPTV model from noisy input/output periods.
+
+    Parameters
+    ----------
+    u, y : array_like, shape (P, N)
+        P >= 2 steady-state periods of input and output. Or pass a :class:`FrequencyData`
+        as ``u`` (and no ``y``).
+    na, nb : int
+        Orders of the output and input sides.
+    ka, kb : int or sequence of int
+        Harmonic count of every a_n (every b_m), or one count per coefficient.
+    w0 : float
+        Fundamental of the period in rad/s (not needed with FrequencyData).
+    ts : float, optional
+        Sample period of a discrete-time model.
+    lines : sequence of int, optional
+        The rows (lines) of the fit. Default: K+1 .. Lmax-K, K the largest harmonic count.
+    method : {'ls', 'tls', 'gtls', 'wgtls'}
+    known : dict, optional
+        Coefficients known exactly, e.g. ``{'a2': 1.5}`` (a constant) or a Fourier row of
+        2K+1 values. With a known coefficient no normalisation is applied.
+    tol, max_iter :
+        WGTLS stops when the relative change of the parameters is below ``tol`` or after
+        ``max_iter`` weighted solves (``converged`` says which).
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)          # 1 / (s + 2)
+    >>> ms = lptv.multisine(range(1, 60), 256, seed=0)
+    >>> y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
+    >>> rng = np.random.default_rng(1)
+    >>> u = ms.periods(4) + 1e-3 * rng.standard_normal((4, 256))
+    >>> y = np.tile(y1, (4, 1)) + 1e-3 * rng.standard_normal((4, 256))
+    >>> res = lptv.identify(u, y, na=1, nb=0, w0=0.1)
+    >>> np.round(res.model.a[:, 0].real, 2)
+    array([2., 1.])
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if isinstance(u, FrequencyData):
+        if y is not None:
+            raise ValueError("y must be omitted when u is a FrequencyData")
+        data = u
+        if w0 is not None and not np.isclose(w0, data.w0):
+            raise ValueError(f"w0={w0} disagrees with the data's w0={data.w0}")
+        if ts is not None and data.ts is not None and not np.isclose(ts, data.ts):
+            raise ValueError(f"ts={ts} disagrees with the data's ts={data.ts}")
+        ts = data.ts if ts is None else ts
+    else:
+        if y is None:
+            raise ValueError("y is missing: pass u and y of shape (P, N), or a FrequencyData")
+        if w0 is None:
+            raise ValueError("w0 is missing: the fundamental of the period (rad/s)")
+        data = FrequencyData.from_periods(u, y, w0=w0, ts=ts)
+    for name, v in (("na", na), ("nb", nb)):
+        if np.ndim(v) != 0 or int(v) != v or v < 0:
+            raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be > 0, got {tol!r}")
+    if int(max_iter) != max_iter or max_iter < 0:
+        raise ValueError(f"max_iter must be a non-negative integer, got {max_iter!r}")
+    na, nb = int(na), int(nb)
+    ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
+    kn = _known_list(known, ka_l, kb_l)
+    par = _core.Parametrisation(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
+    rows = _rows(lines, par, data)
+    par.check_rows(rows, data.max_line)
+
+    r = _core.estimate(data._cpp, par, rows, method=method, tol=float(tol), max_iter=int(max_iter))
+    theta = np.asarray(r["theta"])
+    model = Model._from_core(par.to_model(theta))
+    e, var_e, rn = normalized_residue(model, data, rows, _par=par, _theta=theta)
+    n_free = par.n_xi - 1
+    p_exp, band = expected_fraction_above_0db(len(rows), n_free, data.periods)
+    msgs = []
+    sv = np.asarray(r["singular_values"])
+    if method in ("gtls", "wgtls") and sv.size >= 2 and not r["noise_free"] and sv[1] ** 2 < 2.0 * sv[0] ** 2:
+        msgs.append(
+            f"the two smallest generalised singular values are close ({sv[0]:.3g}, {sv[1]:.3g}): "
+            "the model is nearly unidentifiable; too many harmonics (a common periodic factor of "
+            "numerator and denominator) or too high orders are the likely cause")
+    if method == "wgtls" and not r["converged"]:
+        msgs.append(f"WGTLS did not converge in {max_iter} iterations (tol {tol:g})")
+    if r["noise_free"]:
+        msgs.append("the data carry no noise (zero variances): the noise-weighted estimate reduces to TLS")
+    for msg in msgs:
+        warnings.warn(msg, IdentifiabilityWarning if "unidentifiable" in msg else UserWarning, stacklevel=2)
+    frac = float(np.mean(rn > 1.0))
+    return IdentificationResult(
+        model=model, method=method, lines=np.asarray(rows), theta=theta, eta=np.asarray(r["eta"]),
+        n_free_parameters=n_free, iterations=r["iterations"], converged=r["converged"], cost=r["cost"],
+        cost_history=np.asarray(r["cost_history"]), singular_values=sv, residue=e,
+        residue_variance=var_e, normalized_residue=rn, fraction_above_0db=frac,
+        fraction_expected=p_exp, fraction_band=band, noise_free=r["noise_free"], warnings=tuple(msgs),
+        data=data)
