@@ -59,3 +59,46 @@ def paper_multisine(seed: int = 0, n_samples: int = PAPER_N):
     """The paper-like excitation: lines 10, 20, ..., 240, amplitude sqrt(2/24) each (rms 1)."""
     return multisine(PAPER_EXCITED, n_samples, amplitudes=np.sqrt(2.0 / PAPER_EXCITED.size),
                      seed=seed)
+
+
+def _colored(rng, n, pole):
+    """Unit-rms first-order low-pass noise 1/(1 - pole z^-1), started in its steady state."""
+    from scipy.signal import lfilter
+
+    burn = int(10 / max(1e-3, 1 - abs(pole))) if pole else 0
+    e = rng.standard_normal(n + burn)
+    x = lfilter([1.0], [1.0, -pole], e)[burn:] if pole else e
+    return x / np.sqrt(np.mean(x ** 2))
+
+
+def noisy_periods(u0, y0, periods: int, snr_in_db: float, snr_out_db: float, seed=None,
+                  pole_in: float = 0.0, pole_out: float = 0.0, correlation: float = 0.0):
+    """P noisy periods of the noise-free one-period signals u0, y0.
+
+    Input and output noise are first-order low-pass noise (``pole_in``, ``pole_out``; 0 is
+    white) scaled to the given mean SNRs (20 log10 of signal rms over noise rms); the output
+    noise shares a fraction ``correlation`` of its driving sequence with the input noise, so
+    that the two are correlated line by line.
+
+    Returns
+    -------
+    u, y : ndarrays (P, N)
+    """
+    u0 = np.asarray(u0, float)
+    y0 = np.asarray(y0, float)
+    if u0.shape != y0.shape or u0.ndim != 1:
+        raise ValueError("u0 and y0 must be 1-D periods of the same length")
+    if not -1.0 <= correlation <= 1.0:
+        raise ValueError(f"correlation must lie in [-1, 1], got {correlation}")
+    P, N = int(periods), u0.size
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    su = np.sqrt(np.mean(u0 ** 2)) * 10 ** (-snr_in_db / 20)
+    sy = np.sqrt(np.mean(y0 ** 2)) * 10 ** (-snr_out_db / 20)
+    cu = _colored(rng, P * N, pole_in)
+    # The output noise: a part driven by the input noise sequence, the rest its own.
+    own = _colored(rng, P * N, pole_out)
+    cy = correlation * cu + np.sqrt(1 - correlation ** 2) * own
+    cy = cy / np.sqrt(np.mean(cy ** 2))
+    u = np.tile(u0, (P, 1)) + su * cu.reshape(P, N)
+    y = np.tile(y0, (P, 1)) + sy * cy.reshape(P, N)
+    return u, y
