@@ -1,0 +1,133 @@
+"""Figures of the method (the paper's Figs. 2-6).
+
+Every function takes an optional matplotlib ``ax`` and returns it. Without ``ax`` a new
+:class:`matplotlib.figure.Figure` is made (not through pyplot, so no global state is touched
+and nothing is shown); ``ax.figure`` gives it. Nothing here calls ``plt.show()`` or changes
+matplotlib's settings.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def _axes(ax, figsize=(6.4, 4.0)):
+    if ax is not None:
+        return ax
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=figsize, layout="constrained").subplots()
+
+
+def _db(x):
+    x = np.abs(np.asarray(x))
+    with np.errstate(divide="ignore"):
+        return 20 * np.log10(np.where(x > 0, x, np.nan))
+
+
+def output_spectrum(lines, Y_fds, Y_time=None, *, w0=None, ax=None, labels=("FDS", "CVODE")):
+    """Output spectrum of the FDS, the time integration and their difference in dB (paper Fig. 2).
+
+    Parameters
+    ----------
+    lines : array of int
+    Y_fds, Y_time : complex arrays on ``lines``
+    w0 : float, optional
+        Plot against angular frequency l * w0 (rad/s) instead of the line number.
+    """
+    ax = _axes(ax)
+    lines = np.asarray(lines)
+    x = lines * w0 if w0 else lines
+    ax.plot(x, _db(Y_fds), ".", ms=3, label=labels[0])
+    if Y_time is not None:
+        ax.plot(x, _db(Y_time), "x", ms=3, alpha=0.6, label=labels[1])
+        ax.plot(x, _db(np.asarray(Y_fds) - np.asarray(Y_time)), ".", ms=2, color="C3",
+                label=f"|{labels[0]} - {labels[1]}|")
+    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_ylabel("amplitude (dB)")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    return ax
+
+
+def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zeros_est=None, *,
+                       ax=None, zoom_on_poles=False):
+    """Frozen (instantaneous) poles and zeros over a period, true and estimated (paper Figs. 3, 5)."""
+    ax = _axes(ax)
+    style = {"true": dict(lw=2.0, alpha=0.5), "est": dict(lw=1.0, ls="--")}
+    def curves(arr, marker, color, label, kind):
+        if arr is None:
+            return
+        arr = np.asarray(arr)
+        for j in range(arr.shape[1]):
+            ax.plot(arr[:, j].real, arr[:, j].imag, color=color,
+                    label=label if j == 0 else None, **style[kind])
+            ax.plot(arr[0, j].real, arr[0, j].imag, marker, color=color, ms=6, mfc="none")
+    curves(poles_true, "x", "C0", "poles, true", "true")
+    curves(poles_est, "x", "C3", "poles, estimated", "est")
+    if not zoom_on_poles:
+        curves(zeros_true, "o", "C2", "zeros, true", "true")
+        curves(zeros_est, "o", "C1", "zeros, estimated", "est")
+    ax.set_xlabel("real part")
+    ax.set_ylabel("imaginary part")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    if zoom_on_poles and poles_true is not None:
+        pt = np.asarray(poles_true)
+        pt = pt[np.isfinite(pt)]
+        sel = pt[pt.imag >= 0] if np.any(pt.imag >= 0) else pt
+        pad = 0.15 * max(np.ptp(sel.real), np.ptp(sel.imag), 1e-3)
+        ax.set_xlim(sel.real.min() - pad, sel.real.max() + pad)
+        ax.set_ylim(sel.imag.min() - pad, sel.imag.max() + pad)
+    return ax
+
+
+def prediction_error(lines, noise_std, error, *, w0=None, ax=None, mean_noise_std=None):
+    """Output-noise standard deviation against |true - predicted output| per line (paper Fig. 4)."""
+    ax = _axes(ax)
+    lines = np.asarray(lines)
+    x = lines * w0 if w0 else lines
+    ax.plot(x, _db(noise_std), "-", color="C0", label="output noise std (one period)")
+    if mean_noise_std is not None:
+        ax.plot(x, _db(mean_noise_std), "-", color="C0", alpha=0.4, label="std of the mean of P periods")
+    ax.plot(x, _db(error), ".", ms=3, color="C3", label="|true - predicted output|")
+    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_ylabel("amplitude (dB)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=None):
+    """Normalised residue |e_l| / sqrt(var e_l) per line in dB with the 0 dB line (paper Fig. 6)."""
+    ax = _axes(ax)
+    lines = np.asarray(lines)
+    x = lines * w0 if w0 else lines
+    ax.plot(x, _db(r), ".", ms=4, color="C0")
+    ax.axhline(0.0, color="k", lw=1)
+    title = []
+    if fraction is not None:
+        title.append(f"{100 * fraction:.1f} % above 0 dB")
+    if expected is not None:
+        title.append(f"expected {100 * expected:.1f} %")
+    if title:
+        ax.set_title(", ".join(title))
+    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_ylabel("normalised residue (dB)")
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
+def coefficients(t, true=None, est=None, *, names=None, ax=None):
+    """Coefficient trajectories a_n(t) / b_m(t) over time, true and estimated."""
+    ax = _axes(ax)
+    for arr, ls, lab in ((true, "-", "true"), (est, "--", "estimated")):
+        if arr is None:
+            continue
+        arr = np.asarray(arr)
+        for j in range(arr.shape[1]):
+            name = names[j] if names else f"c{j}"
+            ax.plot(t, arr[:, j], ls, color=f"C{j}", label=f"{name} {lab}")
+    ax.set_xlabel("time (s)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax

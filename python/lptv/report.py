@@ -1,0 +1,90 @@
+"""A small offline HTML report: headings, text, tables and figures (PNG files embedded)."""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import os
+from pathlib import Path
+
+
+class Report:
+    """Collects the pieces of a report and writes ``report.html`` plus the figures as PNG.
+
+    Examples
+    --------
+    >>> import tempfile, lptv
+    >>> from lptv.report import Report
+    >>> r = Report("Example")
+    >>> r.paragraph("One table.")
+    >>> r.table(["a", "b"], [[1, 2.5]])
+    >>> d = tempfile.mkdtemp(); r.write(d).name
+    'report.html'
+    """
+
+    def __init__(self, title: str):
+        self.title = title
+        self._parts = []
+        self._figures = []
+
+    def heading(self, text: str, level: int = 2):
+        self._parts.append(f"<h{level}>{html.escape(text)}</h{level}>")
+
+    def paragraph(self, text: str):
+        self._parts.append(f"<p>{html.escape(text)}</p>")
+
+    def preformatted(self, text: str):
+        self._parts.append(f"<pre>{html.escape(text)}</pre>")
+
+    def table(self, header, rows):
+        def fmt(v):
+            if isinstance(v, float):
+                return f"{v:.4g}"
+            return str(v)
+        head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(fmt(v))}</td>" for v in row) + "</tr>"
+                       for row in rows)
+        self._parts.append(f"<table><tr>{head}</tr>{body}</table>")
+
+    def figure(self, fig, filename: str, caption: str):
+        """Adds a matplotlib figure, saved as ``filename`` (PNG) and embedded in the page."""
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110)
+        data = buf.getvalue()
+        self._figures.append((filename, data))
+        b64 = base64.b64encode(data).decode("ascii")
+        self._parts.append(
+            f'<figure><img alt="{html.escape(filename)}" src="data:image/png;base64,{b64}">'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+    def write(self, out_dir) -> Path:
+        out = Path(os.fspath(out_dir))
+        out.mkdir(parents=True, exist_ok=True)
+        for name, data in self._figures:
+            (out / name).write_bytes(data)
+        style = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}"
+                 "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:.2em .6em;"
+                 "text-align:right}th{background:#eee}figure{margin:1.5em 0}img{max-width:100%}"
+                 "figcaption{font-size:.92em;color:#444}pre{background:#f6f6f6;padding:.6em}")
+        page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(self.title)}"
+                f"</title><style>{style}</style></head><body><h1>{html.escape(self.title)}</h1>"
+                + "\n".join(self._parts) + "</body></html>")
+        path = out / "report.html"
+        path.write_text(page, encoding="utf-8")
+        return path
+
+
+def write_json(path, obj):
+    """JSON with NumPy scalars turned into Python numbers."""
+    import numpy as np
+
+    def conv(o):
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+    with open(os.fspath(path), "w") as f:
+        json.dump(obj, f, indent=1, default=conv)
