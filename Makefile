@@ -20,7 +20,7 @@ APT_BENCH := libsundials-dev
 # dependencies are in pyproject.toml).
 PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
 	numpy==2.4.6 scipy==1.17.1 pytest==9.2.0 hypothesis==6.170.15 matplotlib==3.11.2 \
-	scikit-sundae==1.2.0
+	scikit-sundae==1.2.0 h5py==3.16.0
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
