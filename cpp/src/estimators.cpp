@@ -7,6 +7,13 @@
 
 #include "lptv/errors.hpp"
 #include "lptv/gsvd.hpp"
+#include "rows.hpp"
+
+extern "C" {
+// LAPACK: QR of a triangular-pentagonal pair [A; B] (A upper triangular n x n).
+void dtpqrt_(const int* m, const int* n, const int* l, const int* nb, double* a, const int* lda,
+             double* b, const int* ldb, double* t, const int* ldt, double* work, int* info);
+}
 
 namespace lptv {
 
@@ -44,42 +51,44 @@ std::vector<TextEntry> text_entries(const Parametrisation& p) {
   return out;
 }
 
-// QR of rows [begin, end) into an n x n upper-triangular R, block by block.
+// QR of rows [begin, end) into an n x n upper-triangular R, block by block: each block B of
+// real rows is folded into R by LAPACK's dtpqrt (QR of [R; B] exploiting R's triangle,
+// blocked, on the BLAS), so the Jacobian is never held whole.
 Eigen::MatrixXd r_factor_range(const FrequencyData& d, const Parametrisation& p,
                                const std::vector<int>& rows, const Eigen::VectorXd& weights,
                                size_t begin, size_t end) {
   const int n = p.n_xi();
-  const Structure& s = p.structure();
   const auto entries = text_entries(p);
-  constexpr int kBlock = 512;  // complex rows per block: 2 * 512 real rows
-  Eigen::MatrixXd M(n + 2 * kBlock, n);
+  constexpr int kBlock = 1024;  // complex rows per block: 2 * 1024 real rows
+  const int nb = std::min(n, 32);
+  Eigen::MatrixXd B(2 * kBlock, n), T(nb, n), work(nb, n);
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
+  detail::RowPowers pw(p.structure());
+  const detail::Lines X{d};
   std::vector<cd> jrow(p.n_theta());
   Eigen::VectorXcd xrow(n);
   for (size_t b0 = begin; b0 < end; b0 += kBlock) {
-    const int nb = static_cast<int>(std::min<size_t>(kBlock, end - b0));
-    M.topRows(n) = R;
-    for (int r = 0; r < nb; ++r) {
+    const int m = static_cast<int>(std::min<size_t>(kBlock, end - b0));
+    for (int r = 0; r < m; ++r) {
       const int l = rows[b0 + r];
+      pw.compute(l);
       for (int q = 0; q < p.n_theta(); ++q) {
         const Param& pr = p.params()[q];
         const int i = l - pr.k;
-        const cd X = pr.is_a ? (i >= 0 ? d.Y[i] : std::conj(d.Y[-i]))
-                             : -(i >= 0 ? d.U[i] : std::conj(d.U[-i]));
-        jrow[q] = line_power(s, i, pr.order) * X;
+        jrow[q] = pw(pr.k, pr.order) * (pr.is_a ? X.Y(i) : -X.U(i));
       }
       xrow.setZero();
       for (const auto& e : entries) xrow[e.c] += jrow[e.p] * e.v;
       const double sw = weights.size() ? std::sqrt(weights[b0 + r]) : 1.0;
-      M.row(n + 2 * r) = sw * xrow.real().transpose();
-      M.row(n + 2 * r + 1) = sw * xrow.imag().transpose();
+      B.row(2 * r) = sw * xrow.real().transpose();
+      B.row(2 * r + 1) = sw * xrow.imag().transpose();
     }
-    const int m = n + 2 * nb;
-    Eigen::Ref<Eigen::MatrixXd> Mr = M.topRows(m);
-    Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(Mr);  // in place
-    R = M.topLeftCorner(n, n).triangularView<Eigen::Upper>();
+    const int mr = 2 * m, ldb = static_cast<int>(B.rows()), zero = 0;
+    int info = 0;
+    dtpqrt_(&mr, &n, &zero, &nb, R.data(), &n, B.data(), &ldb, T.data(), &nb, work.data(), &info);
+    if (info != 0) throw NumericalError("QR of the Jacobian (dtpqrt) failed: info " + std::to_string(info));
   }
-  return R;
+  return R.triangularView<Eigen::Upper>();
 }
 
 }  // namespace
@@ -90,17 +99,16 @@ Eigen::MatrixXd weighted_r_factor(const FrequencyData& d, const Parametrisation&
     throw std::invalid_argument("weights must have one entry per row");
   }
   const int n = p.n_xi();
-  // Two halves on two threads when there is enough work; their R factors are merged
-  // by one more small QR.
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  if (hw < 2 || rows.size() < 20000) return r_factor_range(d, p, rows, weights, 0, rows.size());
-  const size_t mid = rows.size() / 2;
-  Eigen::MatrixXd R1;
-  std::thread t([&] { R1 = r_factor_range(d, p, rows, weights, 0, mid); });
-  Eigen::MatrixXd R2 = r_factor_range(d, p, rows, weights, mid, rows.size());
-  t.join();
+  Eigen::MatrixXd parts[2];
+  // Two threads of ours each calling a multithreaded BLAS would oversubscribe the cores.
+  const detail::SingleThreadedBlas guard(rows.size() >= 20000);
+  const int used = detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int part) {
+    parts[part] = r_factor_range(d, p, rows, weights, begin, end);
+  });
+  if (used == 1) return parts[0];
+  // Merge the two triangles with one more small QR.
   Eigen::MatrixXd M(2 * n, n);
-  M << R1, R2;
+  M << parts[0], parts[1];
   Eigen::Ref<Eigen::MatrixXd> Mr = M;
   Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(Mr);
   return M.topRows(n).triangularView<Eigen::Upper>();

@@ -1,5 +1,6 @@
 #include "lptv/jacobian.hpp"
 #include "lptv/errors.hpp"
+#include "rows.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,17 +16,6 @@ namespace {
 std::string coef_name(bool is_a, int order) {
   return std::string(is_a ? "a" : "b") + std::to_string(order);
 }
-
-// Line values with X_{-l} = conj(X_l); the statistics of the conjugate line follow.
-struct LineAccess {
-  const FrequencyData& d;
-  cd Y(int l) const { return l >= 0 ? d.Y[l] : std::conj(d.Y[-l]); }
-  cd U(int l) const { return l >= 0 ? d.U[l] : std::conj(d.U[-l]); }
-  double varY(int l) const { return d.varY[std::abs(l)]; }
-  double varU(int l) const { return d.varU[std::abs(l)]; }
-  // E{dY_l conj(dU_l)}; on a conjugate line it is the conjugate.
-  cd covYU(int l) const { return l >= 0 ? d.covYU[l] : std::conj(d.covYU[-l]); }
-};
 
 }  // namespace
 
@@ -225,7 +215,7 @@ void check_rows(const Parametrisation& p, const std::vector<int>& rows, int max_
 }
 
 Eigen::MatrixXcd jacobian(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows) {
-  const LineAccess X{d};
+  const detail::Lines X{d};
   const Structure& s = p.structure();
   Eigen::MatrixXcd J(rows.size(), p.n_theta());
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -241,16 +231,15 @@ Eigen::MatrixXcd jacobian(const FrequencyData& d, const Parametrisation& p, cons
 
 namespace {
 
-// A_{l,i} and B_{l,i} for i = l - k, k = -K..K (index K + k).
-void band_row(const Parametrisation& p, const Eigen::VectorXcd& theta, int l, int K,
+// A_{l,i} and B_{l,i} for i = l - k, k = -K..K (index K + k), from the row's powers.
+void band_row(const Parametrisation& p, const Eigen::VectorXcd& theta, const detail::RowPowers& pw,
               std::vector<cd>& A, std::vector<cd>& B) {
-  const Structure& s = p.structure();
+  const int K = pw.K();
   A.assign(2 * K + 1, cd(0.0, 0.0));
   B.assign(2 * K + 1, cd(0.0, 0.0));
   for (int q = 0; q < p.n_theta(); ++q) {
     const Param& pr = p.params()[q];
-    const cd f = theta[q] * line_power(s, l - pr.k, pr.order);
-    (pr.is_a ? A : B)[K + pr.k] += f;
+    (pr.is_a ? A : B)[K + pr.k] += theta[q] * pw(pr.k, pr.order);
   }
 }
 
@@ -258,39 +247,47 @@ void band_row(const Parametrisation& p, const Eigen::VectorXcd& theta, int l, in
 
 Eigen::VectorXcd residue(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
                          const Eigen::VectorXcd& theta) {
-  const LineAccess X{d};
-  const int K = p.structure().kmax();
-  std::vector<cd> A, B;
+  const detail::Lines X{d};
   Eigen::VectorXcd e(rows.size());
-  for (size_t r = 0; r < rows.size(); ++r) {
-    band_row(p, theta, rows[r], K, A, B);
-    cd v(0.0, 0.0);
-    for (int k = -K; k <= K; ++k) {
-      const int i = rows[r] - k;
-      v += A[K + k] * X.Y(i) - B[K + k] * X.U(i);
+  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
+    detail::RowPowers pw(p.structure());
+    const int K = pw.K();
+    std::vector<cd> A, B;
+    for (size_t r = begin; r < end; ++r) {
+      pw.compute(rows[r]);
+      band_row(p, theta, pw, A, B);
+      cd v(0.0, 0.0);
+      for (int k = -K; k <= K; ++k) {
+        const int i = rows[r] - k;
+        v += A[K + k] * X.Y(i) - B[K + k] * X.U(i);
+      }
+      e[r] = v;
     }
-    e[r] = v;
-  }
+  });
   return e;
 }
 
 Eigen::VectorXd residue_variance(const FrequencyData& d, const Parametrisation& p,
                                  const std::vector<int>& rows, const Eigen::VectorXcd& theta) {
-  const LineAccess X{d};
-  const int K = p.structure().kmax();
-  std::vector<cd> A, B;
+  const detail::Lines X{d};
   Eigen::VectorXd v(rows.size());
-  for (size_t r = 0; r < rows.size(); ++r) {
-    band_row(p, theta, rows[r], K, A, B);
-    double s = 0;
-    for (int k = -K; k <= K; ++k) {
-      const int i = rows[r] - k;
-      const cd a = A[K + k], b = B[K + k];
-      s += std::norm(a) * X.varY(i) + std::norm(b) * X.varU(i) -
-           2.0 * (a * std::conj(b) * X.covYU(i)).real();
+  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
+    detail::RowPowers pw(p.structure());
+    const int K = pw.K();
+    std::vector<cd> A, B;
+    for (size_t r = begin; r < end; ++r) {
+      pw.compute(rows[r]);
+      band_row(p, theta, pw, A, B);
+      double s = 0;
+      for (int k = -K; k <= K; ++k) {
+        const int i = rows[r] - k;
+        const cd a = A[K + k], b = B[K + k];
+        s += std::norm(a) * X.varY(i) + std::norm(b) * X.varU(i) -
+             2.0 * (a * std::conj(b) * X.covYU(i)).real();
+      }
+      v[r] = s;
     }
-    v[r] = s;
-  }
+  });
   return v;
 }
 
@@ -299,39 +296,45 @@ Eigen::MatrixXcd column_covariance(const FrequencyData& d, const Parametrisation
   if (weights.size() != static_cast<Eigen::Index>(rows.size())) {
     throw std::invalid_argument("weights must have one entry per row");
   }
-  const LineAccess X{d};
-  const Structure& s = p.structure();
-  const int K = s.kmax();
+  const detail::Lines X{d};
+  const int K = p.structure().kmax();
   // Parameters grouped by harmonic: only those share a noisy line within a row.
   std::vector<std::vector<int>> by_k(2 * K + 1);
   for (int q = 0; q < p.n_theta(); ++q) by_k[K + p.params()[q].k].push_back(q);
-  Eigen::MatrixXcd C = Eigen::MatrixXcd::Zero(p.n_theta(), p.n_theta());
-  std::vector<cd> f;
-  for (size_t r = 0; r < rows.size(); ++r) {
-    const double w = weights[r];
-    if (w == 0.0) continue;
-    for (int k = -K; k <= K; ++k) {
-      const auto& group = by_k[K + k];
-      const int i = rows[r] - k;
-      const double vy = X.varY(i), vu = X.varU(i);
-      const cd cyu = X.covYU(i);
-      f.resize(group.size());
-      for (size_t a = 0; a < group.size(); ++a) {
-        const Param& pr = p.params()[group[a]];
-        f[a] = (pr.is_a ? 1.0 : -1.0) * line_power(s, i, pr.order);  // dJ = f dX
-      }
-      for (size_t a = 0; a < group.size(); ++a) {
-        const bool ya = p.params()[group[a]].is_a;
-        for (size_t b = 0; b < group.size(); ++b) {
-          const bool yb = p.params()[group[b]].is_a;
-          // E{conj(dX_a) dX_b}
-          const cd e = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
-          C(group[a], group[b]) += w * std::conj(f[a]) * f[b] * e;
+  Eigen::MatrixXcd parts[2];
+  parts[0] = parts[1] = Eigen::MatrixXcd::Zero(p.n_theta(), p.n_theta());
+  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int part) {
+    Eigen::MatrixXcd& C = parts[part];
+    detail::RowPowers pw(p.structure());
+    std::vector<cd> f;
+    for (size_t r = begin; r < end; ++r) {
+      const double w = weights[r];
+      if (w == 0.0) continue;
+      pw.compute(rows[r]);
+      for (int k = -K; k <= K; ++k) {
+        const auto& group = by_k[K + k];
+        const int i = rows[r] - k;
+        const double vy = X.varY(i), vu = X.varU(i);
+        const cd cyu = X.covYU(i);
+        f.resize(group.size());
+        for (size_t a = 0; a < group.size(); ++a) {
+          const Param& pr = p.params()[group[a]];
+          f[a] = (pr.is_a ? 1.0 : -1.0) * pw(k, pr.order);  // dJ = f dX
+        }
+        for (size_t a = 0; a < group.size(); ++a) {
+          const bool ya = p.params()[group[a]].is_a;
+          const cd wfa = w * std::conj(f[a]);
+          for (size_t b = 0; b < group.size(); ++b) {
+            const bool yb = p.params()[group[b]].is_a;
+            // E{conj(dX_a) dX_b}
+            const cd e = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
+            C(group[a], group[b]) += wfa * f[b] * e;
+          }
         }
       }
     }
-  }
-  return C;
+  });
+  return parts[0] + parts[1];
 }
 
 }  // namespace lptv
