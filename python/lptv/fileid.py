@@ -1,0 +1,540 @@
+"""``lptv identify FILE``: an LPTV model from your own periodic measurements.
+
+The file holds P >= 2 steady-state periods of the input u and the output y:
+
+- CSV: a header row naming the columns ``u`` and ``y`` (other columns are ignored), one sample
+  per row, the periods one after another; ``--periods P`` says how many the record holds.
+- NPZ: arrays ``u`` and ``y`` of shape (P, N), optionally a scalar ``w0`` (rad/s).
+- MATLAB ``.mat`` (v4/v5/v7 via scipy, v7.3 via h5py): variables ``u`` and ``y`` of size P x N,
+  optionally a scalar ``w0``. In NPZ and MAT files, vectors are accepted with ``--periods``.
+
+The period comes from ``--w0`` (rad/s), ``--period`` (s), the file's ``w0`` or, in discrete time,
+from ``--ts`` and the samples per period. The command writes ``model.json`` (readable by
+:meth:`lptv.Model.load`), ``report.html`` with the validation figures, and ``summary.json``, and
+prints the validation verdict. Problems with the file or the options end in a one-line error
+and exit status 2.
+
+Example (the paper's simulation example as a measurement file, then its identification)::
+
+    python -c "import numpy as np, lptv.demo as d; m = d.paper_measurements(); \\
+               np.savez('meas.npz', u=m['u'], y=m['y'], w0=m['w0'])"
+    lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243 --out meas-lptv
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import re
+import sys
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from . import plots
+from ._core import NumericalError
+from .fds import simulate
+from .identify import METHODS, identify
+from .report import Report, write_json
+from .validation import frozen_poles, frozen_zeros
+
+FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
+_MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
+                   "int64", "uint64"}
+
+
+class FileError(Exception):
+    """A problem with the input file or the options that the user can act on."""
+
+
+@dataclass(frozen=True)
+class Measurements:
+    """What a measurement file holds: P periods of N samples of u and y."""
+
+    u: np.ndarray
+    y: np.ndarray
+    w0: Optional[float]
+    format: str
+
+
+# ------------------------------------------------------------------------------ reading
+
+def read_measurements(path, periods: Optional[int] = None) -> Measurements:
+    """Read u, y (shape (P, N)) and an optional w0 from a CSV, NPZ or MATLAB file.
+
+    Raises :class:`FileError` with a message naming the problem (not the file).
+    """
+    path = Path(path)
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise FileError(f"unknown file type '{path.suffix}' (expected .csv, .npz or .mat)")
+    if not path.exists():
+        raise FileError("no such file")
+    if path.is_dir():
+        raise FileError("is a directory, not a measurement file")
+    if periods is not None and periods < 1:
+        raise FileError(f"--periods must be a positive integer, got {periods}")
+    if fmt == "CSV":
+        u, y, w0 = _read_csv(path, periods)
+    elif fmt == "NPZ":
+        u, y, w0 = _read_npz(path, periods)
+    else:
+        u, y, w0, fmt = _read_mat(path, periods)
+    if u.shape != y.shape:
+        raise FileError(f"u and y differ in shape: u is {_shape(u)} and y is {_shape(y)} (periods x samples)")
+    if u.shape[0] < 2:
+        raise FileError("the record holds only 1 period; the noise model needs at least 2")
+    return Measurements(u=u, y=y, w0=w0, format=fmt)
+
+
+def _shape(a):
+    return " x ".join(str(n) for n in a.shape)
+
+
+def _read_csv(path, periods):
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError:
+        raise FileError("not a text file (is it really CSV?)") from None
+    rows = csv.reader(io.StringIO(text), delimiter=_delimiter(text))
+    header = next((r for r in rows if any(c.strip() for c in r)), None)
+    if header is None:
+        raise FileError("the file is empty")
+    names = [c.strip().lower() for c in header]
+    if all(_is_number(c) for c in header):
+        raise FileError("the first row must be a header naming the columns u and y; it holds numbers")
+    cols = {}
+    for name in ("u", "y"):
+        if names.count(name) > 1:
+            raise FileError(f"column '{name}' appears {names.count(name)} times in the header")
+        if name not in names:
+            found = ", ".join(repr(c.strip()) for c in header)
+            raise FileError(f"column '{name}' is missing (the header has {found})")
+        cols[name] = names.index(name)
+    values = {"u": [], "y": []}
+    line_of = []
+    need = max(cols.values()) + 1
+    for row in rows:
+        if not any(c.strip() for c in row):
+            continue
+        if len(row) < need:
+            raise FileError(f"line {rows.line_num}: {len(row)} field(s), the header has {len(header)}")
+        for name, i in cols.items():
+            cell = row[i].strip()
+            try:
+                values[name].append(float(cell))
+            except ValueError:
+                what = "is empty" if not cell else f"'{cell}' is not a number"
+                raise FileError(f"line {rows.line_num}: column '{name}' {what}") from None
+        line_of.append(rows.line_num)
+    if not line_of:
+        raise FileError("no data rows after the header")
+    for name in ("u", "y"):
+        v = np.array(values[name])
+        bad = np.flatnonzero(~np.isfinite(v))
+        if bad.size:
+            raise FileError(f"line {line_of[bad[0]]}: column '{name}' is NaN or inf")
+    if periods is None:
+        raise FileError(f"--periods is required for a CSV record (how many periods its "
+                        f"{len(line_of)} samples hold)")
+    return (_split_periods("column 'u'", np.array(values["u"]), periods),
+            _split_periods("column 'y'", np.array(values["y"]), periods), None)
+
+
+def _delimiter(text):
+    """Comma, semicolon (locales with a decimal comma) or tab, whichever the header uses."""
+    first = next((ln for ln in text.splitlines() if ln.strip()), "")
+    return next((c for c in ",;\t" if c in first), ",")
+
+
+def _is_number(s):
+    try:
+        float(s)
+        return True
+    except ValueError:
+        return False
+
+
+def _split_periods(what, v, periods):
+    if v.size % periods:
+        raise FileError(f"{what} has {v.size} samples, not a whole number of periods "
+                        f"({v.size} / {periods} = {v.size / periods:.6g})")
+    return v.reshape(periods, -1)
+
+
+def _as_periods(name, a, periods):
+    """A (P, N) float array from a file variable; vectors are split with --periods."""
+    what = f"variable '{name}'"
+    a = np.asarray(a)
+    if a.dtype.kind == "c":
+        raise FileError(f"{what} is complex; a measured time signal is real")
+    if a.dtype.kind not in "fiu":
+        raise FileError(f"{what} is not a numeric array (dtype {a.dtype})")
+    if a.size == 0:
+        raise FileError(f"{what} is empty")
+    if a.ndim > 2:
+        raise FileError(f"{what} has {a.ndim} dimensions ({_shape(a)}); expected periods x samples")
+    a = a.astype(float)
+    if a.ndim < 2 or 1 in a.shape:
+        if periods is None:
+            raise FileError(f"{what} is a vector of {a.size} samples: give --periods, "
+                            "the number of periods it holds")
+        a = _split_periods(what, a.ravel(), periods)
+    elif periods is not None and a.shape[0] != periods:
+        raise FileError(f"{what} holds {a.shape[0]} periods ({_shape(a)}) but --periods says {periods}")
+    bad = np.argwhere(~np.isfinite(a))
+    if bad.size:
+        p, n = bad[0] + 1
+        raise FileError(f"{what} is NaN or inf at period {p}, sample {n} (counting from 1)")
+    return a
+
+
+def _file_w0(a):
+    if a is None:
+        return None
+    a = np.asarray(a)
+    if a.dtype.kind not in "fiu" or a.size != 1 or not np.isfinite(a.item()) or a.item() <= 0:
+        raise FileError("variable 'w0' must be a positive scalar (rad/s)")
+    return float(a.item())
+
+
+def _read_npz(path, periods):
+    try:
+        npz = np.load(path, allow_pickle=False)
+    except Exception as e:  # zipfile, pickle and OS errors: all mean "not a readable NPZ"
+        raise FileError(f"cannot read as NPZ: {_one_line(e)}") from None
+    if not isinstance(npz, np.lib.npyio.NpzFile):
+        raise FileError("holds a single array, not an NPZ archive with arrays u and y")
+    with npz:
+        try:
+            arrays = {k: npz[k] for k in ("u", "y", "w0") if k in npz.files}
+        except Exception as e:
+            raise FileError(f"cannot read as NPZ: {_one_line(e)}") from None
+    for name in ("u", "y"):
+        if name not in arrays:
+            raise FileError(f"array '{name}' is missing (the file has {', '.join(npz.files) or 'none'})")
+    return (_as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods),
+            _file_w0(arrays.get("w0")))
+
+
+def _read_mat(path, periods):
+    with open(path, "rb") as f:
+        head = f.read(128)
+    if head.startswith(b"MATLAB 7.3") or head.startswith(b"\x89HDF"):
+        return (*_read_mat73(path, periods), "MAT v7.3")
+    import scipy.io
+
+    try:
+        d = scipy.io.loadmat(path, squeeze_me=False)
+    except Exception as e:  # scipy raises a zoo of types for a damaged or foreign file
+        raise FileError(f"cannot read as a MATLAB file: {_one_line(e)}") from None
+    names = [k for k in d if not k.startswith("__")]
+    for name in ("u", "y"):
+        if name not in d:
+            raise FileError(f"variable '{name}' is missing (the file has {', '.join(names) or 'none'})")
+    return (_as_periods("u", d["u"], periods), _as_periods("y", d["y"], periods),
+            _file_w0(d.get("w0")), "MAT v5")
+
+
+def _read_mat73(path, periods):
+    try:
+        import h5py
+    except ImportError:
+        raise FileError("reading MATLAB v7.3 files needs h5py (pip install h5py)") from None
+    try:
+        with h5py.File(path, "r") as f:
+            names = list(f.keys())
+            arrays = {name: _h5_variable(f, name) for name in ("u", "y", "w0") if name in f}
+    except FileError:
+        raise
+    except Exception as e:
+        raise FileError(f"cannot read as a MATLAB v7.3 (HDF5) file: {_one_line(e)}") from None
+    for name in ("u", "y"):
+        if name not in arrays:
+            raise FileError(f"variable '{name}' is missing (the file has {', '.join(names) or 'none'})")
+    return (_as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods),
+            _file_w0(arrays.get("w0")))
+
+
+def _h5_variable(f, name):
+    import h5py
+
+    obj = f[name]
+    cls = obj.attrs.get("MATLAB_class")
+    cls = cls.decode() if isinstance(cls, bytes) else cls
+    if not isinstance(obj, h5py.Dataset) or (cls is not None and cls not in _MATLAB_NUMERIC):
+        kind = f"a MATLAB {cls}" if cls else "an HDF5 group"
+        raise FileError(f"variable '{name}' is {kind}, not a numeric array")
+    if obj.attrs.get("MATLAB_empty", 0):
+        raise FileError(f"variable '{name}' is empty")
+    if obj.dtype.names:  # MATLAB stores complex arrays as a compound (real, imag)
+        raise FileError(f"variable '{name}' is complex; a measured time signal is real")
+    # MATLAB writes column-major arrays, so HDF5 sees the P x N variable as N x P.
+    return np.asarray(obj[()]).T
+
+
+# ------------------------------------------------------------------------------ options
+
+def parse_lines(text: str) -> np.ndarray:
+    """'1-243', '1-100,120-150' or '10,20,30' -> the line numbers, in the order given."""
+    out = []
+    for tok in text.split(","):
+        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", tok)
+        if not m:
+            raise FileError(f"--lines: '{tok.strip()}' is not a line number or a range like 1-243")
+        lo = int(m.group(1))
+        hi = int(m.group(2)) if m.group(2) else lo
+        if hi < lo:
+            raise FileError(f"--lines: '{tok.strip()}' is an empty range")
+        out.extend(range(lo, hi + 1))
+    values, counts = np.unique(out, return_counts=True)
+    if np.any(counts > 1):
+        raise FileError(f"--lines: line {values[counts > 1][0]} is given twice")
+    return np.array(out)
+
+
+def _counts(text, opt):
+    try:
+        ks = [int(t) for t in text.split(",")]
+    except ValueError:
+        raise FileError(f"{opt}: '{text}' must be an integer or a comma list of integers, "
+                        "one per coefficient") from None
+    if any(k < 0 for k in ks):
+        raise FileError(f"{opt}: harmonic counts must be >= 0, got '{text}'")
+    return ks[0] if len(ks) == 1 else ks
+
+
+def _known(text):
+    if text is None:
+        return None
+    out = {}
+    for tok in text.split(","):
+        name, eq, value = tok.partition("=")
+        name = name.strip()
+        try:
+            v = float(value)
+        except ValueError:
+            v = None
+        if not eq or not name or v is None or not np.isfinite(v):
+            raise FileError(f"--known: '{tok.strip()}' is not of the form name=number (e.g. a2=1.5)")
+        if name in out:
+            raise FileError(f"--known: {name} is given twice")
+        out[name] = v
+    return out
+
+
+def _positive(value, opt):
+    if value is not None and not (np.isfinite(value) and value > 0):
+        raise FileError(f"{opt} must be a positive number, got {value:g}")
+    return value
+
+
+def _fundamental(args, meas):
+    """w0 from --w0 / --period, the file, and (discrete time) --ts with the samples per period."""
+    w0 = _positive(args.w0, "--w0")
+    if _positive(args.period, "--period") is not None:
+        w0 = 2 * np.pi / args.period
+    given = "--w0" if args.w0 is not None else "--period"
+    if meas.w0 is not None:
+        if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
+            raise FileError(f"{given} gives w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
+        w0, given = meas.w0, "the file's w0"
+    if _positive(args.ts, "--ts") is not None:
+        n = meas.u.shape[1]
+        w0_ts = 2 * np.pi / (n * args.ts)
+        if w0 is None:
+            w0 = w0_ts
+        elif not np.isclose(w0, w0_ts, rtol=1e-9, atol=0):
+            # the library would accept it, with the lines mapped to the wrong frequencies
+            raise FileError(f"{given} and --ts {args.ts:g} give {2 * np.pi / (w0 * args.ts):.6g} "
+                            f"samples per period, but the record has {n}")
+    if w0 is None:
+        raise FileError("the period is unknown: give --w0 (rad/s) or --period (s)")
+    return w0
+
+
+def _one_line(e):
+    return " ".join(str(e).split()) or type(e).__name__
+
+
+_HELP = """\
+Identify an LPTV model from P >= 2 measured steady-state periods of input u and output y.
+  .csv  header row naming columns u and y, periods one after another (needs --periods)
+  .npz  arrays u, y of shape (P, N); optional scalar w0 (rad/s)
+  .mat  MATLAB v5 or v7.3: variables u, y of size P x N; optional scalar w0
+Writes model.json, report.html and summary.json, and prints the validation verdict."""
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        "identify", help="identify an LPTV model from a measurement file (CSV, NPZ, MAT)",
+        description=_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="example: lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243")
+    p.add_argument("file", help="measurements: .csv, .npz or .mat")
+    p.add_argument("--na", type=int, required=True, help="order of the output side")
+    p.add_argument("--nb", type=int, required=True, help="order of the input side")
+    p.add_argument("--ka", default="0", help="harmonics of every a_n, or a comma list one per a_n (default 0)")
+    p.add_argument("--kb", default="0", help="harmonics of every b_m, or a comma list one per b_m (default 0)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--w0", type=float, help="fundamental of the period (rad/s)")
+    g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
+    p.add_argument("--ts", type=float, help="sample period: identify a discrete-time model")
+    p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
+    p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150 (default: all usable)")
+    p.add_argument("--method", default="wgtls", choices=METHODS, help="estimator (default wgtls)")
+    p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
+    p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
+    p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
+    p.add_argument("--tol", type=float, default=1e-10, help="WGTLS relative tolerance (default 1e-10)")
+    return p
+
+
+def _fail(name, problem) -> int:
+    print(f"lptv identify: error: {name}: {_one_line(problem)}", file=sys.stderr)
+    return 2
+
+
+# ------------------------------------------------------------------------------ running
+
+def run(args) -> int:
+    src = args.file
+    try:
+        lines = parse_lines(args.lines) if args.lines is not None else None
+        ka, kb, known = _counts(args.ka, "--ka"), _counts(args.kb, "--kb"), _known(args.known)
+        if args.max_iter < 0:
+            raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
+        _positive(args.tol, "--tol")
+        meas = read_measurements(src, args.periods)
+        w0 = _fundamental(args, meas)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts,
+                           lines=lines, method=args.method, known=known, tol=args.tol,
+                           max_iter=args.max_iter)
+            Y_pred = simulate(res.model, res.data.U)
+    except (FileError, ValueError, NumericalError) as e:
+        return _fail(src, e)
+    # identify's own warnings are in res.warnings (and so in its summary); keep the others
+    extra = [str(w.message) for w in caught if str(w.message) not in res.warnings]
+
+    P, N = meas.u.shape
+    out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
+    print(f"lptv identify: {src} ({meas.format}, {P} periods of {N} samples, w0 = {w0:.6g} rad/s"
+          + (f", ts = {args.ts:g} s" if args.ts else "") + f") -> {out}/")
+    print(res.summary())
+    for msg in extra:
+        print(f"warning: {msg}")
+    summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        res.model.save(out / "model.json")
+        write_json(out / "summary.json", summary)
+        _report(src, meas, res, Y_pred, summary).write(out)
+    except OSError as e:
+        return _fail(e.filename or out, e.strerror or e)
+    except ImportError:
+        return _fail(src, "writing report.html needs matplotlib (pip install 'lptv[plots]')")
+    print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
+    return 0
+
+
+def _prediction_gap_db(res, Y_pred):
+    """Mean power of Y - Y_pred over that of the mean's output noise, on the fit rows (dB)."""
+    rows = res.lines
+    err = np.mean(np.abs(res.data.Y[rows] - Y_pred[rows]) ** 2)
+    noise = np.mean(res.data.varY[rows])
+    return float(10 * np.log10(err / noise)) if noise > 0 and err > 0 else None
+
+
+def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
+    P, N = meas.u.shape
+    return {
+        "file": str(args.file), "format": meas.format, "periods": P, "samples_per_period": N,
+        "w0": w0, "ts": args.ts, "na": res.model.na, "nb": res.model.nb,
+        "ka": ka, "kb": kb, "method": res.method,
+        "n_lines": int(res.lines.size), "first_line": int(res.lines.min()),
+        "last_line": int(res.lines.max()), "n_free_parameters": res.n_free_parameters,
+        "iterations": res.iterations, "converged": res.converged, "cost": res.cost,
+        "fraction_above_0db": res.fraction_above_0db, "fraction_expected": res.fraction_expected,
+        "fraction_band": list(res.fraction_band), "residue_ok": res.residue_ok,
+        "prediction_error_vs_noise_db": _prediction_gap_db(res, Y_pred),
+        "warnings": list(res.warnings) + extra,
+    }
+
+
+def _db(x):
+    x = np.abs(np.asarray(x))
+    with np.errstate(divide="ignore"):
+        return 20 * np.log10(np.where(x > 0, x, np.nan))
+
+
+def _report(src, meas, res, Y_pred, summary) -> Report:
+    from matplotlib.figure import Figure
+
+    model, d, rows = res.model, res.data, res.lines
+    P, N = meas.u.shape
+    lo, hi = res.fraction_band
+    rep = Report(f"lptv identify: {Path(src).name}")
+    rep.paragraph(
+        f"A model with na = {model.na}, nb = {model.nb}, {summary['ka']} harmonics on the a_n and "
+        f"{summary['kb']} on the b_m ({res.n_free_parameters} free parameters) identified by "
+        f"{res.method.upper()} from {P} periods of {N} samples in {src}, on {rows.size} lines "
+        f"({rows.min()} to {rows.max()}).")
+    rep.preformatted(res.summary())
+    gap = summary["prediction_error_vs_noise_db"]
+    rep.table(["quantity", "value"], [
+        ["file", f"{src} ({meas.format})"],
+        ["periods x samples", f"{P} x {N}"],
+        ["w0 (rad/s)", f"{model.w0:.6g}" + (f", ts = {model.ts:g} s" if model.discrete else "")],
+        ["na, nb; harmonics ka, kb", f"{model.na}, {model.nb}; {summary['ka']}, {summary['kb']}"],
+        ["lines of the fit", f"{rows.size} ({rows.min()} to {rows.max()})"],
+        ["method, iterations, converged", f"{res.method}, {res.iterations}, {res.converged}"],
+        ["normalised residues above 0 dB", f"{100 * res.fraction_above_0db:.1f} % (expected "
+         f"{100 * res.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %)"],
+        ["output residue against the noise", "-" if gap is None else f"{gap:+.1f} dB"],
+    ])
+
+    ax = plots.normalized_residue(rows, res.normalized_residue, fraction=res.fraction_above_0db,
+                                  expected=res.fraction_expected)
+    rep.figure(ax.figure, "normalized_residue.png",
+               f"Normalised residue |e_l| / sqrt(var e_l) per line against 0 dB: "
+               f"{100 * res.fraction_above_0db:.1f} % of the lines lie above, where noise alone gives "
+               f"{100 * res.fraction_expected:.1f} % (band {100 * lo:.1f}-{100 * hi:.1f} %); "
+               + ("the fit shows no sign of modelling errors." if res.residue_ok else
+                  "outside that band the residue holds more than noise: check the orders and harmonics."))
+
+    t = np.linspace(0.0, model.period, 400)
+    ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t))
+    rep.figure(ax.figure, "frozen_poles_zeros.png",
+               "Frozen (instantaneous) poles and zeros of the estimate over one period, markers at "
+               f"t = 0 ({'z' if model.discrete else 's'}-plane). They show how the system varies "
+               "and say nothing about the stability of the time-varying system.")
+
+    ax = Figure(figsize=(6.4, 4.0), layout="constrained").subplots()
+    for v, style, label in ((d.Y[rows], ".", "measured output |Y| (mean of the periods)"),
+                            (Y_pred[rows], "x", "model output from the measured input"),
+                            (d.Y[rows] - Y_pred[rows], ".", "residue Y - Y_model"),
+                            (np.sqrt(d.varY[rows]), "-", "noise std of the mean output")):
+        ax.plot(rows, _db(v), style, ms=3, label=label)
+    ax.set_xlabel("line")
+    ax.set_ylabel("amplitude (dB)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    rep.figure(ax.figure, "output_spectrum.png",
+               "Measured output spectrum, the output the model predicts from the measured input, their "
+               f"difference and the noise standard deviation of the mean of the {P} periods (one "
+               f"period's is sqrt({P}) larger). "
+               + (f"The difference is on average {gap:+.1f} dB from the noise level; a good model keeps "
+                  "it near the noise (the measured input is noisy too), far below |Y| on the excited lines."
+                  if gap is not None else ""))
+
+    names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
+    coef = np.hstack([model.a_at(t), model.b_at(t)]).real
+    ax = plots.coefficients(t, est=coef, names=names)
+    rep.figure(ax.figure, "coefficients.png",
+               "The estimated coefficients a_n(t) and b_m(t) over one period (normalised so that "
+               "the mean of a_na is 1, unless coefficients were given as known).")
+    return rep
