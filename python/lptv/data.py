@@ -95,6 +95,11 @@ class FrequencyData:
             raise ValueError(f"u and y must have the same shape (P, N), got {u.shape} and {y.shape}")
         if u.shape[0] < 2:
             raise ValueError(f"u, y: at least 2 periods are needed for a noise model, got P = {u.shape[0]}")
+        if ts is not None and w0 is not None and np.isfinite(ts) and np.isfinite(w0) and ts > 0 and w0 > 0:
+            n_expected = 2 * np.pi / (w0 * ts)
+            if abs(n_expected - u.shape[1]) > 1e-6 * u.shape[1]:
+                raise ValueError(f"u, y: {u.shape[1]} samples per period, but w0 = {w0:g} and ts = {ts:g} "
+                                 f"give 2 pi / (w0 ts) = {n_expected:.6g}")
         obj = cls.__new__(cls)
         obj._set(_core.FrequencyData.from_periods(u, y), w0, ts)
         return obj

@@ -8,6 +8,8 @@ import json
 import os
 from pathlib import Path
 
+import numpy as np
+
 
 class Report:
     """Collects the pieces of a report and writes ``report.html`` plus the figures as PNG.
@@ -39,8 +41,14 @@ class Report:
 
     def table(self, header, rows):
         def fmt(v):
-            if isinstance(v, float):
-                return f"{v:.4g}"
+            if isinstance(v, (bool, np.bool_)):
+                return str(bool(v))
+            if isinstance(v, (float, np.floating)):
+                return f"{float(v):.4g}"
+            if isinstance(v, (int, np.integer)):
+                return str(int(v))
+            if isinstance(v, (list, tuple, np.ndarray)):
+                return "[" + ", ".join(fmt(x) for x in v) + "]"
             return str(v)
         head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
         body = "".join("<tr>" + "".join(f"<td>{html.escape(fmt(v))}</td>" for v in row) + "</tr>"
@@ -77,8 +85,6 @@ class Report:
 
 def write_json(path, obj):
     """JSON with NumPy scalars turned into Python numbers."""
-    import numpy as np
-
     def conv(o):
         if isinstance(o, np.generic):
             return o.item()

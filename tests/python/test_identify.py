@@ -286,3 +286,9 @@ def test_error_missing_w0(small_periods):
     u, y = small_periods
     with pytest.raises(ValueError, match="w0 is missing"):
         lptv.identify(u, y, na=1, nb=0)
+
+
+def test_error_ts_does_not_fit_the_period(small_periods):
+    u, y = small_periods
+    with pytest.raises(ValueError, match="64 samples per period, but w0 = 0.1 and ts = 0.2"):
+        lptv.identify(u, y, na=1, nb=0, w0=0.1, ts=0.2)
