@@ -1,0 +1,26 @@
+"""The same mathematics as the compiled core, written plainly with NumPy.
+
+An independent route for the tests and benchmarks: dense matrices, dense solves, ``numpy.fft``.
+It reads a model's coefficient arrays and never calls the core's computations.
+"""
+from .fds import (
+    band_matrix_A,
+    band_matrix_B,
+    coefficients_at,
+    crest_factor,
+    full_spectrum,
+    grid,
+    htf,
+    line_variable,
+    multisine_spectrum,
+    samples_per_period,
+    simulate,
+    spectrum,
+    time_signal,
+)
+
+__all__ = [
+    "band_matrix_A", "band_matrix_B", "coefficients_at", "crest_factor", "full_spectrum", "grid",
+    "htf", "line_variable", "multisine_spectrum", "samples_per_period", "simulate", "spectrum",
+    "time_signal",
+]

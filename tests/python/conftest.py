@@ -1,0 +1,232 @@
+"""Tolerances and random models shared by the tests of the model, multisines and FDS.
+
+Every tolerance of these tests is set here, next to the conditioning argument behind it.
+The random models are generated so that the premises of those arguments hold, and the tests
+check the premises (a condition number, a decay) instead of assuming them.
+"""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import lptv
+
+EPS = np.finfo(float).eps
+
+# ---------------------------------------------------------------------------------- tolerances
+
+# C++ FDS against the dense NumPy reference on the same grid, relative to the largest output
+# line. Both are backward-stable LU solves of the same system, so each has a forward error of
+# about c eps kappa, kappa = || |A^-1| |A| ||_inf (Skeel's condition number: the one that
+# governs after the row scaling both sparse solvers apply), with c a modest growth factor (the
+# worst-case c ~ n is not approached by pivoted LU; measured c < 1 on these models). The random
+# models keep kappa <= KAPPA_MAX (checked by the tests): 100 * 2.2e-16 = 2.2e-14 per route,
+# so 1e-12 leaves a factor 20 for growth on either side. Measured: below 2e-15.
+FDS_VS_REFERENCE = 1e-12
+KAPPA_MAX = 100.0
+
+# Entries of the band matrices, relative to sum_n max_k |c_{n,k}| |s_i|^n of their column:
+# each is a sum of at most na+1 <= 4 products of a coefficient and a power built by at most 3
+# multiplications, so its rounding error is below 8 eps = 1.8e-15. The margin covers pow()
+# in the reference against repeated multiplication in the core, and exp(j w ts) against polar.
+BAND_ENTRY = 1e-14
+
+# LTI line by line against scipy.signal.freqs / freqz. Horner (scipy) and summed powers (FDS)
+# each evaluate B and A to (nb + na + 2) eps times the evaluation condition numbers
+# sum |c_n| |s|^n / |C(s)|, which the LTI test models keep below POLY_COND_MAX (checked):
+# 8 * 2.2e-16 * 100 * 2 routes = 3.5e-13.
+LTI_VS_SCIPY = 1e-12
+POLY_COND_MAX = 100.0
+
+# a_n(t), b_m(t) from the core against the reference's Fourier sums, relative to
+# sum_k |c_{n,k}|: the phases k w0 t reach 2 pi K P for |t| <= P periods, and their rounding
+# (~ eps 2 pi K P = 1e-14 for K <= 3, P <= 2) dominates.
+COEFFICIENTS_AT = 1e-13
+
+# Signals and spectra of length N <= 4096 from the core's FFT (kissfft) against numpy.fft and
+# against direct sums of cosines, relative to sum_l |X_l| (the largest |x| can be): FFT
+# rounding grows like eps log2 N ~ 3e-15; the direct sums use exact integer phase reduction.
+SIGNAL = 1e-13
+
+# A handful of floating-point operations on the same data (|exp(j phi)|, an angle, max / rms,
+# a mean of squares that is exactly 1): a few eps each; 16 eps keeps them honest but robust to
+# libm differences between the core (std::cos) and numpy (SIMD cos).
+ROUNDING = 16 * EPS
+
+# Periodic steady state of a discrete-time model solved in the time domain (an N x N dense
+# system) against the reference: the same conditioning argument as FDS_VS_REFERENCE.
+TIME_DOMAIN = 1e-12
+
+# Continuous-time ODE residual sum_n a_n(t) y^(n)(t) - sum_m b_m(t) u^(m)(t), with y and its
+# derivatives synthesised from L <= 90 output lines, relative to the sum of the magnitudes of
+# all the terms: the phases l w0 t reach 2 pi L in one period and round to ~ 2 pi L eps =
+# 1.3e-13; the truncated lines beyond L are below 1e-16 of the output for the default models
+# (checked by the test).
+ODE_RESIDUAL = 1e-12
+
+SEEDS = [0, 1, 2, 3, 4]
+SOLVERS = ["klu", "umfpack"]
+
+
+@pytest.fixture(scope="session")
+def tol():
+    """The tolerances above as one namespace (session scope, so hypothesis tests may use it)."""
+    return SimpleNamespace(
+        EPS=EPS, FDS_VS_REFERENCE=FDS_VS_REFERENCE, KAPPA_MAX=KAPPA_MAX, BAND_ENTRY=BAND_ENTRY,
+        LTI_VS_SCIPY=LTI_VS_SCIPY, POLY_COND_MAX=POLY_COND_MAX, COEFFICIENTS_AT=COEFFICIENTS_AT,
+        SIGNAL=SIGNAL, ROUNDING=ROUNDING, TIME_DOMAIN=TIME_DOMAIN, ODE_RESIDUAL=ODE_RESIDUAL)
+
+
+@pytest.fixture(params=SEEDS, ids=lambda s: f"seed{s}")
+def seed(request):
+    return request.param
+
+
+@pytest.fixture(params=SOLVERS)
+def solver(request):
+    return request.param
+
+
+@pytest.fixture(params=["ct", "dt"])
+def domain(request):
+    return request.param
+
+
+# ------------------------------------------------------------------------------ random models
+
+def _coefficient_row(rng, dc, K, depth):
+    """Harmonics -K..K around a real DC value, scaled so that the coefficient stays within
+    dc (1 +- depth) at all times (2 sum_k |c_k| = depth |dc|)."""
+    row = np.zeros(2 * K + 1, complex)
+    row[K] = dc
+    if K:
+        c = rng.normal(size=K) + 1j * rng.normal(size=K)
+        c *= depth * abs(dc) / (2 * np.abs(c).sum())
+        row[K + 1:] = c
+        row[:K] = np.conj(c[::-1])
+    return row
+
+
+def _roots(rng, n, discrete):
+    """n roots in conjugate pairs, well inside the stable region: Re s <= -0.2 or |z| <= 0.8."""
+    pairs, single = divmod(n, 2)
+    if discrete:
+        cplx = rng.uniform(0.2, 0.8, pairs) * np.exp(1j * rng.uniform(0.1, 3.0, pairs))
+        real = rng.uniform(-0.8, 0.8, single)
+    else:
+        cplx = -rng.uniform(0.2, 1.5, pairs) + 1j * rng.uniform(0.3, 3.0, pairs)
+        real = -rng.uniform(0.2, 2.0, single)
+    return np.concatenate([cplx, np.conj(cplx), real])
+
+
+def random_model(seed, domain, lti=False, depth=0.2, ka=None, kb=None):
+    """A random stable model: mean system with poles (and zeros) well inside the stable region,
+    every coefficient varying within dc (1 +- depth).
+
+    Continuous time: w0 in [0.1, 0.5] rad/s, so lines 0..30 sweep the poles' frequencies.
+    Discrete time: ts = 1 and N in {16, 25, 32, 47, 64} (odd and even, with and without Nyquist).
+    """
+    rng = np.random.default_rng([seed, 0 if domain == "ct" else 1, int(lti)])
+    discrete = domain == "dt"
+    na = int(rng.integers(1, 4))
+    nb = int(rng.integers(0, na + 1))
+    if ka is None:
+        ka = 0 if lti else int(rng.integers(1, 4))
+    if kb is None:
+        kb = 0 if lti else int(rng.integers(0, 4))
+    # Zeros placed like the poles keep |B| away from zero on the grid as well as |A|.
+    a_dc = np.atleast_1d(np.real(np.poly(_roots(rng, na, discrete))))[::-1]
+    b_dc = rng.uniform(0.5, 2.0) * np.atleast_1d(np.real(np.poly(_roots(rng, nb, discrete))))[::-1]
+    a = np.array([_coefficient_row(rng, c, ka, depth) for c in a_dc])
+    b = np.array([_coefficient_row(rng, c, kb, depth) for c in b_dc])
+    if discrete:
+        N = int(rng.choice([16, 25, 32, 47, 64]))
+        return lptv.Model(a, b, w0=2 * np.pi / N, ts=1.0)
+    return lptv.Model(a, b, w0=float(rng.uniform(0.1, 0.5)))
+
+
+def random_spectrum(seed, model, Lu=None, ncols=3):
+    """One-sided input spectra (Lu+1, ncols) of real signals: DC (and a Nyquist line) real.
+
+    Discrete time defaults to the whole one-sided grid 0..N//2; continuous time to 0..30.
+    """
+    rng = np.random.default_rng([seed, 7])
+    if Lu is None:
+        Lu = model.samples_per_period // 2 if model.discrete else 30
+    U = rng.normal(size=(Lu + 1, ncols)) + 1j * rng.normal(size=(Lu + 1, ncols))
+    U[0] = U[0].real
+    if model.discrete and 2 * Lu == model.samples_per_period:
+        U[Lu] = U[Lu].real
+    return U
+
+
+def skeel_condition(A):
+    """|| |A^-1| |A| ||_inf of a dense matrix."""
+    return float(np.max(np.sum(np.abs(np.linalg.inv(A)) @ np.abs(A), axis=1)))
+
+
+@pytest.fixture(scope="session")
+def make_model():
+    return random_model
+
+
+@pytest.fixture(scope="session")
+def make_spectrum():
+    return random_spectrum
+
+
+@pytest.fixture(scope="session")
+def kappa():
+    return skeel_condition
+
+
+# ==================================================================================================
+# Identification: tests/python/test_identification_reference.py (the core against
+# lptv.reference.identification, exact data, Monte Carlo). Tolerances of that file only.
+# ==================================================================================================
+
+# Noise statistics, J, e, var e, C, CJ_W and R^T R, core against reference, each relative to the
+# magnitude of the terms it sums (so that cancellation counts against neither route): an entry is
+# a sum of at most P (statistics) or (na+nb+2)(2K+1) <= 35 products, <= 35 eps = 8e-15 of its
+# terms; C and CJ are positive semidefinite (|C_pq| <= sqrt(C_pp C_qq)), so norm-wise is
+# entry-wise; Householder QR is backward stable, ||R^T R - Jx^T Jx|| <= c m n eps ||Jx||^2 with
+# m n <= 500 * 20 rows x columns: 2e-12 in the worst case. Measured: 1e-16 .. 1e-15.
+ID_STEP = 1e-11
+# Estimates (theta, eta, cost, generalised singular values), core against reference: both are
+# backward stable (QR/GSVD against SVD/pivoted Cholesky), so each is within ~ eps kappa of the
+# exact estimate, kappa = sigma_max / (sigma_2 - sigma_1) of the (whitened, column-scaled)
+# problem (Wedin's bound on the singular vector; see estimate_condition in the test file). The
+# test problems keep kappa <= ID_COND_MAX (checked): 2.2e-16 * 1e5 = 2.2e-11 per route at the
+# bound. WGTLS adds the stopping rule: each route stops within ~1e-12 of the same fixed point.
+# Measured: 1e-15 .. 1e-13 (kappa 3 .. 1.2e4, the paper-like example under GTLS the largest).
+ID_ESTIMATE = 1e-10
+ID_COND_MAX = 1e5
+# Noise-free data (FDS truncation 1e-13, FFT rounding 1e-16 relative): the estimate's error is
+# that residue times the condition of the exact problem, sigma_max / sigma_{n-1} of the
+# column-scaled Jx (checked <= ID_NOISELESS_COND_MAX: 1e-10 at the bound; measured <= 30).
+ID_NOISELESS = 1e-9
+ID_NOISELESS_COND_MAX = 1e3
+# WGTLS cost against mean |e|^2/var e at the fixed point: the weights come from the previous
+# iterate, within TOL = 1e-12 relative, and var e is at most ~1e2 times as sensitive.
+ID_SELF_CHECK = 1e-8
+# Monte Carlo: sample means compared within ID_MC_SIGMAS standard errors (estimated from the
+# draws); over <= 60 rows and a few tests the chance of a false alarm is ~1e-5 (the draws are
+# seeded, so a run is reproducible anyway). 2e4 draws resolve 3.5 % of the residue variance,
+# well below the 30-90 % the correlation term changes it by (the test checks that it rejects
+# the variance without it).
+ID_MC_DRAWS = 20000
+ID_MC_SIGMAS = 5.0
+ID_FRACTION_DRAWS = 200000
+# The expected fraction of residues above 0 dB: closed form (1 + 1/(c(P-1)))^-(P-1) against
+# scipy.stats' F survival function, both to a few eps.
+ID_FRACTION = 1e-12
+
+
+@pytest.fixture(scope="session")
+def id_tol():
+    """The identification tolerances above as one namespace."""
+    return SimpleNamespace(
+        EPS=EPS, STEP=ID_STEP, ESTIMATE=ID_ESTIMATE, COND_MAX=ID_COND_MAX, NOISELESS=ID_NOISELESS,
+        NOISELESS_COND_MAX=ID_NOISELESS_COND_MAX,
+        SELF_CHECK=ID_SELF_CHECK, MC_DRAWS=ID_MC_DRAWS, MC_SIGMAS=ID_MC_SIGMAS,
+        FRACTION_DRAWS=ID_FRACTION_DRAWS, FRACTION=ID_FRACTION)
