@@ -82,5 +82,19 @@ bench: deps-bench python
 	$(CMAKE) --build $(BUILDROOT)/bench -j $(JOBS)
 	$(MAKE) --no-print-directory -C . bench-run
 
+# Runs the built benchmarks (about 5 minutes on 2 cores); every output is also kept in
+# $(BENCH_OUT) for bench/RESULTS.md. Smaller runs: make bench BENCH_MAX_LINES=1000000.
+BENCH_BIN := $(BUILDROOT)/bench/bench/cpp
+BENCH_OUT := $(BUILDROOT)/bench/results
+BENCH_MAX_LINES ?= 10000000
+BENCH_PY_MAX_LINES ?= 1000000
+.PHONY: bench-run
+bench-run:
+	@mkdir -p $(BENCH_OUT)
+	@echo "machine: $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), load average $$(cut -d' ' -f1-3 /proc/loadavg)" | tee $(BENCH_OUT)/machine.txt
+	set -o pipefail; ./$(BENCH_BIN)/bench_fds_cvode 1 | tee $(BENCH_OUT)/fds_cvode.txt
+	set -o pipefail; ./$(BENCH_BIN)/bench_fds_scaling $(BENCH_MAX_LINES) | tee $(BENCH_OUT)/fds_scaling.txt
+	set -o pipefail; $(PY) bench/python/bench_simulate.py $(BENCH_PY_MAX_LINES) | tee $(BENCH_OUT)/simulate.txt
+
 clean:
 	rm -rf $(BUILDROOT)

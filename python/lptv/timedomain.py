@@ -248,7 +248,7 @@ def _algebraic(model, forcing, t):
     return r / a0
 
 
-def _ct_steady_state(model, U, n_samples, options, atol, t_start):
+def _ct_steady_state(model, U, n_samples, options, atol):
     forcing = _Forcing(model, U, "U")
     T0, na = model.period, model.na
     t = np.arange(n_samples) * (T0 / n_samples)
@@ -393,7 +393,7 @@ def periodic_steady_state(model: Model, U, n_samples: Optional[int] = None, *,
         if n_samples is None:
             raise ValueError("n_samples must be given (a positive integer) in continuous time")
         options = _ct_options(rtol, atol, method, max_num_steps)
-        out = _ct_steady_state(model, U, int(n_samples), options, atol, t_start)
+        out = _ct_steady_state(model, U, int(n_samples), options, atol)
     t, y, x0, Phi, per_err, n_rhs = out
     if not full_output:
         return y
