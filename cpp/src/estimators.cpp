@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
@@ -135,7 +136,12 @@ GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
   // eigenvalues of the (positive semidefinite) covariance are set to zero.
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Cs);
   if (es.info() != Eigen::Success) throw NumericalError("eigendecomposition of the column covariance failed");
-  const Eigen::VectorXd lam = es.eigenvalues().cwiseMax(0.0);
+  // Eigenvalues at rounding level (|lambda| <= n eps max lambda) are directions without
+  // noise: set to zero, so that the GSVD sees them as infinite pairs rather than as tiny
+  // noise giving spurious finite generalised singular values.
+  const double lmax = std::max(es.eigenvalues().maxCoeff(), 0.0);
+  const double cut = double(n) * std::numeric_limits<double>::epsilon() * lmax;
+  const Eigen::VectorXd lam = es.eigenvalues().unaryExpr([cut](double v) { return v > cut ? v : 0.0; });
   const Eigen::MatrixXd S = lam.cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
   const GeneralizedPairs g = gsvd_pairs(Rs, S);
   if (g.values.size() == 0) throw NumericalError("GSVD: no finite generalised singular value");

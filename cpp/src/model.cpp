@@ -29,6 +29,11 @@ void check_coefficients(const Eigen::MatrixXcd& c, const char* name) {
   for (Eigen::Index n = 0; n < c.rows(); ++n) {
     for (Eigen::Index k = 0; k <= K; ++k) {
       const cd d = c(n, K + k) - std::conj(c(n, K - k));
+      if (std::abs(d) > tol && k == 0) {
+        msg << name << " is not conjugate-symmetric: row " << n << ", harmonic 0 is " << c(n, K)
+            << " but must be real (the mean of a real coefficient)";
+        throw std::invalid_argument(msg.str());
+      }
       if (std::abs(d) > tol) {
         msg << name << " is not conjugate-symmetric: row " << n << ", harmonic " << k
             << " is " << c(n, K + k) << " but harmonic " << -k << " is " << c(n, K - k)

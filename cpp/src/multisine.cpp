@@ -35,10 +35,13 @@ Eigen::VectorXcd multisine_spectrum(const std::vector<int>& lines, const Eigen::
 }
 
 Eigen::VectorXd time_signal(const Eigen::VectorXcd& X, int n_samples) {
+  if (n_samples < 1) throw std::invalid_argument("n_samples must be >= 1, got " + std::to_string(n_samples));
+  if (!X.allFinite()) throw std::invalid_argument("X contains NaN or inf");
   const int half = n_samples / 2;
   if (X.size() < 1 || X.size() - 1 > half) {
     throw std::invalid_argument("X must have between 1 and n_samples/2+1 lines");
   }
+  if (n_samples == 1) return Eigen::VectorXd::Constant(1, X[0].real());  // Eigen's FFT needs N >= 2
   std::vector<std::complex<double>> full(n_samples, 0.0);
   for (Eigen::Index l = 0; l < X.size(); ++l) {
     full[l] += X[l];
@@ -55,6 +58,8 @@ Eigen::VectorXd time_signal(const Eigen::VectorXcd& X, int n_samples) {
 Eigen::VectorXcd spectrum(const Eigen::VectorXd& x) {
   const int n = static_cast<int>(x.size());
   if (n < 1) throw std::invalid_argument("x must not be empty");
+  if (!x.allFinite()) throw std::invalid_argument("x contains NaN or inf");
+  if (n == 1) return Eigen::VectorXcd::Constant(1, x[0]);  // Eigen's FFT needs N >= 2
   Eigen::FFT<double> fft;
   std::vector<double> in(x.data(), x.data() + n);
   std::vector<std::complex<double>> X;

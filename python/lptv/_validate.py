@@ -9,9 +9,49 @@ def _array(x, name):
         arr = np.asarray(x)
     except Exception as e:  # ragged lists etc.
         raise ValueError(f"{name} must be array-like: {e}") from None
-    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool):
+    # kinds b, i, u, f, c: booleans and numbers (not timedelta, datetime, strings, objects)
+    if arr.dtype.kind not in "biufc":
         raise ValueError(f"{name} must be numeric, got dtype {arr.dtype}")
     return arr
+
+
+INT_MAX = 2**31 - 1  # the core indexes lines and samples with C int
+
+
+def as_int(x, name, minimum=0, maximum=INT_MAX):
+    """A whole number in [minimum, maximum], or a ValueError naming the argument."""
+    if isinstance(x, (bool, np.bool_)) or np.ndim(x) != 0:
+        raise ValueError(f"{name} must be an integer, got {x!r}")
+    try:
+        v = float(x) if not isinstance(x, (int, np.integer)) else x
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an integer, got {x!r}") from None
+    if isinstance(v, float) and (not np.isfinite(v) or v != np.floor(v)):
+        raise ValueError(f"{name} must be an integer, got {x!r}")
+    v = int(v)
+    if v < minimum:
+        kind = {0: "a non-negative integer", 1: "a positive integer"}.get(minimum, f"an integer >= {minimum}")
+        raise ValueError(f"{name} must be {kind}, got {v}")
+    if v > maximum:
+        raise ValueError(f"{name} must be at most {maximum}, got {v}")
+    return v
+
+
+def as_str(x, name, choices):
+    if not isinstance(x, str) or x not in choices:
+        opts = ", ".join(repr(c) for c in choices[:-1]) + f" or {choices[-1]!r}"
+        raise ValueError(f"{name} must be {opts}, got {x!r}")
+    return x
+
+
+def as_positive_float(x, name):
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be positive and finite, got {x!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise ValueError(f"{name} must be positive and finite, got {x!r}")
+    return v
 
 
 def check_finite(arr, name):

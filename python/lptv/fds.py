@@ -8,7 +8,9 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core
-from ._validate import as_spectrum
+from ._validate import as_int, as_positive_float, as_spectrum, as_str
+
+SOLVERS = ("auto", "klu", "umfpack")
 from .model import Model
 
 
@@ -77,20 +79,17 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     """
     _check_model(model)
     Ua, was_1d = as_spectrum(U, "U")
-    if lines_out is not None and (int(lines_out) != lines_out or lines_out < 0):
-        raise ValueError(f"lines_out must be a non-negative integer, got {lines_out!r}")
-    if guard is not None and (int(guard) != guard or guard < 0):
-        raise ValueError(f"guard must be a non-negative integer, got {guard!r}")
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be positive, got {tol!r}")
-    r = _core.simulate(model._cpp, Ua, solver=solver,
-                       lines_out=-1 if lines_out is None else int(lines_out),
-                       guard=-1 if guard is None else int(guard), tol=float(tol),
-                       max_guard=-1 if max_guard is None else int(max_guard))
+    lines_out = -1 if lines_out is None else as_int(lines_out, "lines_out")
+    guard = -1 if guard is None else as_int(guard, "guard")
+    max_guard = -1 if max_guard is None else as_int(max_guard, "max_guard")
+    tol = as_positive_float(tol, "tol")
+    solver = as_str(solver, "solver", SOLVERS)
+    r = _core.simulate(model._cpp, Ua, solver=solver, lines_out=lines_out, guard=guard, tol=tol,
+                       max_guard=max_guard)
     Y = np.asarray(r["Y"])
     if was_1d:
         Y = Y[:, 0]
-    if not r["converged"] and not model.discrete and not model.is_lti:
+    if not r["converged"] and guard < 0 and not model.discrete and not model.is_lti:
         warnings.warn(
             f"FDS truncation error {r['truncation_error']:.2e} is above tol={tol:g} "
             f"with {r['guard']} guard lines; pass a larger max_guard or guard",
@@ -118,15 +117,20 @@ def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str
     G : ndarray (grid size, len(lines)); row i is output line i - L (continuous) or i (discrete).
     """
     _check_model(model)
-    if int(L) != L or L < 0:
-        raise ValueError(f"L must be a non-negative integer, got {L!r}")
-    n = model.samples_per_period if model.discrete else 2 * int(L) + 1
+    L = as_int(L, "L")
+    solver = as_str(solver, "solver", SOLVERS)
+    n = model.samples_per_period if model.discrete else 2 * L + 1
     if lines is None:
-        lines = range(n) if model.discrete else range(-int(L), int(L) + 1)
-    return np.asarray(_core.htf(model._cpp, int(L), [int(x) for x in lines], solver))
+        lines = range(n) if model.discrete else range(-L, L + 1)
+    try:
+        lines = [as_int(x, "lines", minimum=-2**31 + 1) for x in lines]
+    except TypeError:
+        raise ValueError(f"lines must be a sequence of integers, got {lines!r}") from None
+    return np.asarray(_core.htf(model._cpp, L, lines, solver))
 
 
 def band_matrices(model: Model, L: int = 0):
     """The sparse band matrices (A, B) of METHOD.md eq. 5 as scipy.sparse CSC matrices."""
     _check_model(model)
-    return _core.band_matrix(model._cpp, int(L), True), _core.band_matrix(model._cpp, int(L), False)
+    L = as_int(L, "L")
+    return _core.band_matrix(model._cpp, L, True), _core.band_matrix(model._cpp, L, False)

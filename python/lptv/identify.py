@@ -11,7 +11,7 @@ import numpy as np
 from . import _core
 from .data import FrequencyData
 from .model import Model
-from .validation import expected_fraction_above_0db, normalized_residue
+from .validation import expected_fraction_above_0db
 
 METHODS = ("ls", "tls", "gtls", "wgtls")
 
@@ -216,7 +216,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     r = _core.estimate(data._cpp, par, rows, method=method, tol=float(tol), max_iter=int(max_iter))
     theta = np.asarray(r["theta"])
     model = Model._from_core(par.to_model(theta))
-    e, var_e, rn = normalized_residue(model, data, rows, _par=par, _theta=theta)
+    e = np.asarray(_core.residue(data._cpp, par, rows, theta))
+    var_e = np.asarray(_core.residue_variance(data._cpp, par, rows, theta))
+    positive = var_e > 0
+    # Noise-free rows have no normalised residue; they are NaN, and a warning below says why.
+    rn = np.full(e.shape, np.nan)
+    rn[positive] = np.abs(e[positive]) / np.sqrt(var_e[positive])
     n_free = par.n_xi - 1
     p_exp, band = expected_fraction_above_0db(len(rows), n_free, data.periods)
     msgs = []
@@ -230,9 +235,13 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         msgs.append(f"WGTLS did not converge in {max_iter} iterations (tol {tol:g})")
     if r["noise_free"]:
         msgs.append("the data carry no noise (zero variances): the noise-weighted estimate reduces to TLS")
+    if not positive.all():
+        msgs.append(f"the residue variance is zero on {int((~positive).sum())} of {len(rows)} rows "
+                    "(no noise there): their normalised residues are NaN and the 0 dB fraction "
+                    "is taken over the other rows")
     for msg in msgs:
         warnings.warn(msg, IdentifiabilityWarning if "unidentifiable" in msg else UserWarning, stacklevel=2)
-    frac = float(np.mean(rn > 1.0))
+    frac = float(np.mean(rn[positive] > 1.0)) if positive.any() else float("nan")
     return IdentificationResult(
         model=model, method=method, lines=np.asarray(rows), theta=theta, eta=np.asarray(r["eta"]),
         n_free_parameters=n_free, iterations=r["iterations"], converged=r["converged"], cost=r["cost"],

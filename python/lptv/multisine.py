@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from ._validate import as_real_1d
+from ._validate import as_int, as_real_1d, as_spectrum
 
 
 @dataclass(frozen=True)
@@ -59,15 +59,14 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
     >>> abs(ms.spectrum[10])
     np.float64(0.5)
     """
-    if int(n_samples) != n_samples or n_samples < 1:
-        raise ValueError(f"n_samples must be a positive integer, got {n_samples!r}")
-    n_samples = int(n_samples)
+    n_samples = as_int(n_samples, "n_samples", minimum=1)
     ln = np.atleast_1d(np.asarray(lines))
     if ln.size == 0:
         raise ValueError("lines must not be empty")
     if not np.issubdtype(ln.dtype, np.integer):
-        if not (np.issubdtype(ln.dtype, np.floating) and np.all(ln == np.round(ln))):
-            raise ValueError(f"lines must be integers, got {ln.dtype}")
+        if not (np.issubdtype(ln.dtype, np.floating) and np.all(np.isfinite(ln))
+                and np.all(ln == np.round(ln))):
+            raise ValueError(f"lines must be integers, got {ln.dtype} values")
         ln = ln.astype(int)
     if ln.ndim != 1:
         raise ValueError(f"lines must be 1-D, got shape {ln.shape}")
@@ -96,6 +95,21 @@ def spectrum(x) -> np.ndarray:
 
 
 def time_signal(X, n_samples: int) -> np.ndarray:
-    """One period of the real signal whose one-sided spectrum is X (lines 0..L, L <= N/2)."""
-    X = np.asarray(X, dtype=complex).ravel()
-    return np.asarray(_core.time_signal(X, int(n_samples)))
+    """One period of the real signal whose one-sided spectrum is X (lines 0..L, L <= N/2).
+
+    ``X[0]`` (and ``X[N/2]`` for even N) must be real, as for a real signal.
+    """
+    n_samples = as_int(n_samples, "n_samples", minimum=1)
+    Xa, was_1d = as_spectrum(X, "X")
+    if not was_1d:
+        raise ValueError(f"X must be 1-D (lines 0..L), got shape {np.shape(X)}")
+    Xa = Xa[:, 0]
+    if Xa.size > n_samples // 2 + 1:
+        raise ValueError(f"X must have between 1 and {n_samples // 2 + 1} lines (0..n_samples//2) "
+                         f"for n_samples = {n_samples}, got {Xa.size}")
+    scale = max(np.abs(Xa).max(), 1e-300)
+    real_lines = [0] + ([n_samples // 2] if n_samples % 2 == 0 and Xa.size > n_samples // 2 else [])
+    for l in real_lines:
+        if abs(Xa[l].imag) > 1e-12 * scale:
+            raise ValueError(f"X: line {l} must be real for a real signal, got {Xa[l]}")
+    return np.asarray(_core.time_signal(Xa, n_samples))

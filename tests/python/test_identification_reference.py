@@ -406,10 +406,6 @@ def test_noiseless_spectra_with_variances_recover_truth(seed, domain, lti, varia
         assert rel(rr["theta"], case.theta_true) <= id_tol.NOISELESS, method
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError, reason=(
-    "lptv.identify raises ValueError on noise-free data: identify.py calls "
-    "validation.normalized_residue, which rejects var e = 0, although the core falls back to "
-    "TLS and IdentificationResult has a noise_free field and a warning for this case"))
 @pytest.mark.parametrize("domain", ["ct", "dt"])
 def test_identify_accepts_noise_free_periods(domain, id_tol):
     case = make_case(0, domain, False, "plain")
@@ -556,12 +552,6 @@ def test_estimates_with_rounding_level_input_noise(id_tol):
     assert rounding >= 4  # the premise: these cases do exercise rounding-level variances
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "gtls_from_r (cpp/src/estimators.cpp) clamps only negative eigenvalues of the scaled CJ "
-    "before the square root; rounding-level positive ones (|lambda| <~ n eps max lambda) become "
-    "rows of size ~sqrt(eps) in CJ^(1/2), which the GSVD takes as noise, so noise-free "
-    "directions come out as finite generalised singular values of 1e9..1e16 and their count "
-    "depends on rounding"))
 def test_generalised_values_with_rounding_level_input_noise(id_tol):
     for case, dc, d, rows in _rounding_level_cases():
         rc = _core.estimate(dc, core_par(case), [int(r) for r in rows], method="gtls")
