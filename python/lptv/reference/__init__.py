@@ -2,7 +2,12 @@
 
 An independent route for the tests and benchmarks: dense matrices, dense solves, ``numpy.fft``.
 It reads a model's coefficient arrays and never calls the core's computations.
+
+- :mod:`lptv.reference.fds` (re-exported here): model, band matrices, FDS, multisines;
+- :mod:`lptv.reference.identification`: noise model, Jacobian, residue variance, column
+  covariance, LS / TLS / GTLS / WGTLS.
 """
+from . import identification
 from .fds import (
     band_matrix_A,
     band_matrix_B,
@@ -20,7 +25,7 @@ from .fds import (
 )
 
 __all__ = [
-    "band_matrix_A", "band_matrix_B", "coefficients_at", "crest_factor", "full_spectrum", "grid",
+    "identification", "band_matrix_A", "band_matrix_B", "coefficients_at", "crest_factor", "full_spectrum", "grid",
     "htf", "line_variable", "multisine_spectrum", "samples_per_period", "simulate", "spectrum",
     "time_signal",
 ]
