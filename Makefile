@@ -82,7 +82,7 @@ bench: deps-bench python
 	$(CMAKE) --build $(BUILDROOT)/bench -j $(JOBS)
 	$(MAKE) --no-print-directory -C . bench-run
 
-# Runs the built benchmarks (about 5 minutes on 2 cores); every output is also kept in
+# Runs the built benchmarks (2 to 4 minutes on 2 cores); every output is also kept in
 # $(BENCH_OUT) for bench/RESULTS.md. Smaller runs: make bench BENCH_MAX_LINES=1000000.
 BENCH_BIN := $(BUILDROOT)/bench/bench/cpp
 BENCH_OUT := $(BUILDROOT)/bench/results

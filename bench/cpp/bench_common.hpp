@@ -70,6 +70,20 @@ double median_time(int reps, F&& f) {
   return t[t.size() / 2];
 }
 
+// Shortest wall time in seconds of `reps` calls of f (after one warm-up call): on a shared
+// machine the fastest run is the one least disturbed by other work.
+template <class F>
+double min_time(int reps, F&& f) {
+  f();
+  double best = 1e300;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
 // max |Y - Yref| / max |Yref| over the first `lines` + 1 rows.
 inline double rel_error(const Eigen::VectorXcd& Y, const Eigen::VectorXcd& Yref, int lines) {
   const double peak = Yref.head(lines + 1).cwiseAbs().maxCoeff();

@@ -230,7 +230,7 @@ int main(int argc, char** argv) {
   std::printf("FDS vs CVODE, paper-like example (na=2, nb=1, K=3, w0=%g, N=%d, lines 10..240 step "
               "10, seed %u)\n", bench::kW0, N, seed);
   std::printf("errors: max over lines |Y - Yref| / max |Yref|, Yref = FDS with 1024 guard lines;\n"
-              "'all' = lines 0..%d, 'band' = lines 0..%d; times are medians\n\n", half, band);
+              "'all' = lines 0..%d, 'band' = lines 0..%d; times are the fastest of several runs\n\n", half, band);
 
   // -- the FDS ----------------------------------------------------------------------------
   std::printf("%-44s %10s %10s %10s\n", "FDS", "time [ms]", "err all", "err band");
@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
     opt.guard = c.guard;
     Eigen::VectorXcd Y;
     Route r;
-    r.time = bench::median_time(51, [&] { Y = lptv::simulate(model, Uin, opt).Y.col(0); });
+    r.time = bench::min_time(51, [&] { Y = lptv::simulate(model, Uin, opt).Y.col(0); });
     Eigen::VectorXcd Yfull = Eigen::VectorXcd::Zero(half + 1);
     Yfull.head(c.lines_out + 1) = Y;
     r.err_all = bench::rel_error(Yfull, Yref, half);
@@ -285,7 +285,7 @@ int main(int argc, char** argv) {
       Eigen::VectorXd y;
       CvodeRow row{it, rtol, {}};
       const int reps = rtol >= 1e-10 ? 7 : 3;
-      row.r.time = bench::median_time(reps, [&] {
+      row.r.time = bench::min_time(reps, [&] {
         stats = CvodeStats();
         y = cv.steady_state(N, &stats);
         (void)lptv::spectrum(y);

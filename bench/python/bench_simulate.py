@@ -9,7 +9,8 @@ every line 0..L; the output on lines 0..L. The routes:
   storage built from model.a in NumPy (building A and B U is timed as well);
 - ``dense``: numpy.linalg.solve on the dense A (lptv.reference when present), small L only.
 
-Every call is timed whole (Python overhead included); medians over repetitions. The routes
+Every call is timed whole (Python overhead included); the routes take turns, and each one's
+fastest round is reported (the least disturbed by other work on the machine). The routes
 must agree to 1e-10 of the output peak (asserted): all solve the same linear system, A is
 diagonally dominant (harmonics below 40 % of the DC coefficient in every row), so their
 difference is rounding.
@@ -99,21 +100,26 @@ def dense_route(model, U, guard):
     return np.linalg.solve(A, B @ F)[L:L + Lu + 1]
 
 
-def timed(f, reps):
-    out = f()  # warm-up, also the result that is compared
-    t = []
-    for _ in range(reps):
-        t0 = time.perf_counter()
-        f()
-        t.append(time.perf_counter() - t0)
-    return float(np.median(t)), out
+def timed(routes, reps):
+    """Minimum wall time of each callable over `reps` rounds, and its result.
+
+    The routes take turns within each round, so that a change of the machine's load
+    affects them alike; the minimum is the least disturbed run (the machine is shared)."""
+    out = [f() for f in routes]  # warm-up, also the results that are compared
+    t = np.full((reps, len(routes)), np.inf)
+    for r in range(reps):
+        for i, f in enumerate(routes):
+            t0 = time.perf_counter()
+            f()
+            t[r, i] = time.perf_counter() - t0
+    return t.min(axis=0), out
 
 
 def main(max_lines: int = 10**6):
     model = ex.paper_model()
     rng = np.random.default_rng(0)
     print(f"lptv.simulate vs scipy.linalg.solve_banded vs dense ({DENSE_SOURCE}); paper-like "
-          f"model, input on every line 0..L, output lines 0..L; median wall times, calls whole")
+          f"model, input on every line 0..L, output lines 0..L; minimum wall times over interleaved rounds, calls whole")
     print(f"default solver: {lptv.simulate(model, np.ones(3), full_output=True).solver}\n")
     head = (f"{'L':>8} {'guard':>5} {'simulate':>10} {'simulate/g':>10} {'banded':>10} "
             f"{'dense':>10} {'sim/banded':>10} {'sim/g/band':>10} {'dense/sim':>10} {'max diff':>9}")
@@ -122,18 +128,19 @@ def main(max_lines: int = 10**6):
     while L <= max_lines:
         U = np.exp(2j * np.pi * rng.uniform(size=L + 1)) / np.sqrt(L)
         U[0] = U[0].real
-        reps = int(max(1, min(15, 3e5 / L)))
-        t_sim, r = timed(lambda: lptv.simulate(model, U, full_output=True), reps)
-        g = r.guard
-        t_simg, Yg = timed(lambda: lptv.simulate(model, U, guard=g), reps)
-        t_band, Yb = timed(lambda: banded_route(model, U, g), reps)
-        routes = [r.Y, Yg, Yb]
+        reps = int(max(5, min(15, 3e5 / L))) if L < 10**6 else 3
+        g = lptv.simulate(model, U, full_output=True).guard
+        (t_sim, t_simg, t_band), (r, Yg, Yb) = timed(
+            [lambda: lptv.simulate(model, U, full_output=True),
+             lambda: lptv.simulate(model, U, guard=g),
+             lambda: banded_route(model, U, g)], reps)
+        results = [r.Y, Yg, Yb]
         t_dense = np.nan
         if L <= DENSE_MAX_LINES:
-            t_dense, Yd = timed(lambda: dense_route(model, U, g), 1)
-            routes.append(Yd)
+            (t_dense,), (Yd,) = timed([lambda: dense_route(model, U, g)], 1)
+            results.append(Yd)
         peak = np.abs(Yb).max()
-        diff = max(np.abs(Y - Yb).max() for Y in routes) / peak
+        diff = max(np.abs(Y - Yb).max() for Y in results) / peak
         assert diff <= AGREE, f"routes disagree at L = {L}: {diff:.1e}"
         print(f"{L:>8} {g:>5} {1e3 * t_sim:>8.2f}ms {1e3 * t_simg:>8.2f}ms "
               f"{1e3 * t_band:>8.2f}ms {1e3 * t_dense:>8.1f}ms {t_sim / t_band:>10.2f} "
@@ -142,10 +149,10 @@ def main(max_lines: int = 10**6):
     # The fixed cost of one call: a tiny system, where the solve itself is negligible.
     U = np.zeros(11, complex)
     U[10] = 0.5
-    t_small, r = timed(lambda: lptv.simulate(model, U, full_output=True), 200)
-    g = r.guard
-    t_small_g, _ = timed(lambda: lptv.simulate(model, U, guard=g), 200)
-    t_small_b, _ = timed(lambda: banded_route(model, U, g), 200)
+    g = lptv.simulate(model, U, full_output=True).guard
+    (t_small, t_small_g, t_small_b), _ = timed(
+        [lambda: lptv.simulate(model, U), lambda: lptv.simulate(model, U, guard=g),
+         lambda: banded_route(model, U, g)], 200)
     print(f"\ncall overhead, L = 10 (guard {g}): simulate {1e6 * t_small:.0f} us, simulate/g "
           f"{1e6 * t_small_g:.0f} us, banded {1e6 * t_small_b:.0f} us")
     print("ratios > 1 mean lptv.simulate is slower; goal: sim/banded <= 1 at L = 10^5")
