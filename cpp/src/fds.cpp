@@ -71,12 +71,61 @@ SpMat build_band(const Model& m, const Grid& g, const Eigen::MatrixXcd& c) {
 SpMat build_A(const Model& m, const Grid& g) { return build_band(m, g, m.a()); }
 SpMat build_B(const Model& m, const Grid& g) { return build_band(m, g, m.b()); }
 
-Fds::Fds(const Model& m, int L, Solver solver) : grid_(make_grid(m, L)), B_(build_B(m, grid_)) {
-  const SpMat A = build_A(m, grid_);
+namespace {
+
+// A in LAPACK band storage (kl = ku = Ka): ab[(2K + k) + j * ldab] = A(j + k, j).
+std::vector<cd> band_storage_A(const Model& m, const Grid& g) {
+  const int K = m.ka(), na = m.na(), ld = BandLU::ldab(K, K);
+  std::vector<cd> ab(static_cast<size_t>(ld) * g.N, cd(0.0, 0.0));
+  std::vector<cd> pw(na + 1);
+  for (int j = 0; j < g.N; ++j) {
+    const int i = g.line_of(j);
+    for (int n = 0; n <= na; ++n) pw[n] = line_power(m, g, i, n);
+    for (int k = -K; k <= K; ++k) {
+      const int row = j + k;
+      if (row < 0 || row >= g.N) continue;
+      cd v(0.0, 0.0);
+      for (int n = 0; n <= na; ++n) v += m.a()(n, K + k) * pw[n];
+      ab[(2 * K + k) + static_cast<size_t>(j) * ld] = v;
+    }
+  }
+  return ab;
+}
+
+}  // namespace
+
+Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& U) {
+  const int K = m.kb(), nb = m.nb();
+  Eigen::MatrixXcd out = Eigen::MatrixXcd::Zero(g.N, U.cols());
+  std::vector<cd> pw(nb + 1);
+  for (int j = 0; j < g.N; ++j) {
+    if (U.row(j).isZero(0.0)) continue;
+    const int i = g.line_of(j);
+    for (int n = 0; n <= nb; ++n) pw[n] = line_power(m, g, i, n);
+    for (int k = -K; k <= K; ++k) {
+      const int row = g.index_of(i + k);
+      if (row < 0) continue;
+      cd v(0.0, 0.0);
+      for (int n = 0; n <= nb; ++n) v += m.b()(n, K + k) * pw[n];
+      if (v != cd(0.0, 0.0)) out.row(row) += v * U.row(j);
+    }
+  }
+  return out;
+}
+
+Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L)) {
+  solver_ = solver == Solver::Auto ? default_solver(grid_.circular) : solver;
   const Grid g = grid_;
-  lu_ = std::make_unique<SparseLU>(A, solver, [g](int col) {
-    return "line " + std::to_string(g.line_of(col));
-  });
+  auto label = [g](int col) { return "line " + std::to_string(g.line_of(col)); };
+  if (solver_ == Solver::Band) {
+    if (grid_.circular) {
+      throw std::invalid_argument("solver: the band solver needs the continuous-time grid; the "
+                                  "discrete-time grid wraps around (use 'klu' or 'umfpack')");
+    }
+    band_ = std::make_unique<BandLU>(grid_.N, m.ka(), m.ka(), band_storage_A(m, grid_), label);
+  } else {
+    lu_ = std::make_unique<SparseLU>(build_A(m, grid_), solver_, label);
+  }
 }
 
 Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
@@ -84,7 +133,8 @@ Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
     throw std::invalid_argument("U must have " + std::to_string(grid_.N) +
                                 " rows (the grid), got " + std::to_string(U.rows()));
   }
-  return lu_->solve(B_ * U);
+  const Eigen::MatrixXcd rhs = apply_B(model_, grid_, U);
+  return band_ ? band_->solve(rhs) : lu_->solve(rhs);
 }
 
 Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {
@@ -98,7 +148,7 @@ Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {
     }
     rhs(idx, static_cast<Eigen::Index>(j)) = 1.0;
   }
-  return lu_->solve(B_ * rhs);
+  return solve_full(rhs);
 }
 
 namespace {
@@ -116,10 +166,12 @@ void check_input(const Eigen::MatrixXcd& U) {
   }
 }
 
-// One-sided spectra on lines 0..Lu -> full grid (conjugate lines filled in).
+// One-sided spectra on lines 0..Lu -> full grid (conjugate lines filled in). Lines beyond
+// a continuous-time grid must be zero (the caller sizes the grid to the last nonzero one).
 Eigen::MatrixXcd to_full(const Grid& g, const Eigen::MatrixXcd& U) {
   Eigen::MatrixXcd F = Eigen::MatrixXcd::Zero(g.N, U.cols());
-  for (Eigen::Index l = 0; l < U.rows(); ++l) {
+  const Eigen::Index rows = g.circular ? U.rows() : std::min<Eigen::Index>(U.rows(), g.L + 1);
+  for (Eigen::Index l = 0; l < rows; ++l) {
     F.row(g.index_of(static_cast<int>(l))) = U.row(l);
     if (l > 0) F.row(g.index_of(-static_cast<int>(l))) += U.row(l).conjugate();
   }
@@ -131,10 +183,21 @@ Eigen::MatrixXcd to_full(const Grid& g, const Eigen::MatrixXcd& U) {
   return F;
 }
 
+// Lines 0..lines_out of a full-grid solution; lines beyond a continuous-time grid are zero
+// (the truncation the guard controls).
 Eigen::MatrixXcd to_onesided(const Grid& g, const Eigen::MatrixXcd& Y, int lines_out) {
-  Eigen::MatrixXcd out(lines_out + 1, Y.cols());
-  for (int l = 0; l <= lines_out; ++l) out.row(l) = Y.row(g.index_of(l));
+  Eigen::MatrixXcd out = Eigen::MatrixXcd::Zero(lines_out + 1, Y.cols());
+  const int top = g.circular ? lines_out : std::min(lines_out, g.L);
+  for (int l = 0; l <= top; ++l) out.row(l) = Y.row(g.index_of(l));
   return out;
+}
+
+// The highest line with a nonzero input (0 for an all-zero input).
+int last_nonzero_line(const Eigen::MatrixXcd& U) {
+  for (Eigen::Index l = U.rows() - 1; l > 0; --l) {
+    if (!U.row(l).isZero(0.0)) return static_cast<int>(l);
+  }
+  return 0;
 }
 
 }  // namespace
@@ -168,7 +231,9 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
   }
 
   const int lines_out = opt.lines_out < 0 ? Lu : opt.lines_out;
-  const int band = std::max(Lu, lines_out);
+  // The output beyond the last excited line only decays, so the grid starts there (or at
+  // the lines asked for explicitly); trailing zero lines of U cost nothing.
+  const int band = std::max(last_nonzero_line(U), opt.lines_out < 0 ? 0 : opt.lines_out);
   const int K = std::max(1, m.kmax());
   auto run = [&](int guard) {
     Fds fds(m, band + guard, opt.solver);
@@ -181,6 +246,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     return res;
   }
   if (opt.guard >= 0) {
+    const int band = std::max(Lu, lines_out);  // the documented grid of a fixed guard
     // Fixed guard: the lines beyond the grid are taken as zero; the size of the
     // outermost K computed lines tells how wrong that is.
     Fds fds(m, band + opt.guard, opt.solver);

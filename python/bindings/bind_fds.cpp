@@ -45,5 +45,6 @@ void bind_fds(py::module_& m) {
         "guard"_a = -1, "tol"_a = 1e-13, "max_guard"_a = -1);
   m.def("htf", &htf_py, "model"_a, "L"_a, "lines"_a, "solver"_a = "auto");
   m.def("band_matrix", &band_py, "model"_a, "L"_a, "a"_a = true);
-  m.def("default_solver", []() { return lptv::solver_name(lptv::default_solver()); });
+  m.def("default_solver", [](bool discrete) { return lptv::solver_name(lptv::default_solver(discrete)); },
+        "discrete"_a = false);
 }

@@ -10,7 +10,7 @@ import numpy as np
 from . import _core
 from ._validate import as_int, as_positive_float, as_spectrum, as_str
 
-SOLVERS = ("auto", "klu", "umfpack")
+SOLVERS = ("auto", "band", "klu", "umfpack")
 from .model import Model
 
 
@@ -31,7 +31,7 @@ class SimulationResult:
     converged: bool
     """Whether the truncation error met ``tol``."""
     solver: str
-    """Sparse LU backend used ('klu' or 'umfpack')."""
+    """Factorisation used ('band', 'klu' or 'umfpack')."""
 
 
 def _check_model(model, name="model"):
@@ -61,7 +61,10 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
         grows until the returned lines change by less than ``tol`` relative to the largest.
     tol : float
         Relative truncation tolerance of the adaptive guard.
-    solver : {'auto', 'klu', 'umfpack'}
+    solver : {'auto', 'band', 'klu', 'umfpack'}
+        The factorisation of A: 'auto' is LAPACK's band LU in continuous time (A has 2K+1
+        diagonals) and SuiteSparse's KLU in discrete time (the band wraps around the corners,
+        so 'band' is refused there).
     full_output : bool
         Return a :class:`SimulationResult` instead of ``Y``.
 

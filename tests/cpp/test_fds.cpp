@@ -83,3 +83,22 @@ TEST_CASE("multisine spectrum and time signal round-trip", "[multisine]") {
   }
   REQUIRE((lptv::spectrum(x) - X).cwiseAbs().maxCoeff() < 1e-14);
 }
+
+TEST_CASE("band and sparse backends agree on an LPTV model", "[fds]") {
+  Eigen::MatrixXcd a(3, 5), b(2, 3);
+  a << cd(0.02, 0.01), cd(0.1, 0.05), 1.0, cd(0.1, -0.05), cd(0.02, -0.01),
+      0.0, cd(-0.05, 0.02), 0.8, cd(-0.05, -0.02), 0.0,
+      0.0, 0.0, 1.0, 0.0, 0.0;
+  b << cd(0.08, -0.03), 1.0, cd(0.08, 0.03), 0.0, 0.5, 0.0;
+  lptv::Model m(a, b, 0.2);
+  Eigen::MatrixXcd U = Eigen::MatrixXcd::Zero(41, 2);
+  for (int l = 1; l <= 30; l += 3) U(l, 0) = std::polar(1.0, 0.7 * l), U(l, 1) = std::polar(0.5, -0.2 * l);
+  lptv::SimulateOptions opt;
+  opt.guard = 40;
+  opt.solver = lptv::Solver::Band;
+  const auto band = lptv::simulate(m, U, opt);
+  opt.solver = lptv::Solver::KLU;
+  const auto klu = lptv::simulate(m, U, opt);
+  REQUIRE(band.solver == lptv::Solver::Band);
+  REQUIRE((band.Y - klu.Y).cwiseAbs().maxCoeff() <= 1e-13 * klu.Y.cwiseAbs().maxCoeff());
+}

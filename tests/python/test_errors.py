@@ -246,7 +246,7 @@ def test_not_a_model():
 
 def test_unknown_solver():
     check(lambda: lptv.simulate(lti(), np.ones(3), solver="lu"), ValueError,
-          r"^solver must be 'auto', 'klu' or 'umfpack', got 'lu'")
+          r"^solver must be 'auto', 'band', 'klu' or 'umfpack', got 'lu'")
     check(lambda: lptv.htf(lti(), 3, solver="dense"), ValueError, r"^solver must be")
 
 
@@ -271,9 +271,10 @@ def test_crest_factor_of_zero_signal():
 # ------------------------------------------------------------------ numerical failures
 
 SOLVERS = ["klu", "umfpack"]
+CT_SOLVERS = SOLVERS + ["band"]
 
 
-@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("solver", CT_SOLVERS)
 def test_pole_on_a_continuous_grid_line(solver):
     # s^2 + 4 with w0 = 1: poles at +-2j, lines +-2; A(2j) is exactly zero in floating point.
     model = lptv.Model([[4.0], [0.0], [1.0]], [[1.0]], w0=1.0)
@@ -294,7 +295,7 @@ def test_pole_on_a_discrete_grid_line(solver, line):
           rf"^A is singular at line ({line}|{(N - line) % N})\b")
 
 
-@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("solver", CT_SOLVERS)
 def test_pole_on_a_continuous_grid_line_up_to_rounding(solver):
     # s^2 + 0.04 with w0 = 0.1: poles at +-0.2j = line +-2, but (0.2j)^2 + 0.04 = -6.9e-18.
     model = lptv.Model([[0.04], [0.0], [1.0]], [[1.0]], w0=0.1)
@@ -339,3 +340,8 @@ def run_isolated(code):
 def test_length_one_and_zero_periods_do_not_crash(code):
     r = run_isolated("import lptv\n" + textwrap.dedent(code))
     assert r.returncode == 0, f"exit code {r.returncode}: {r.stderr[-500:]}"
+
+
+def test_band_solver_refused_on_the_discrete_grid():
+    check(lambda: lptv.simulate(dt_model(), [1.0, 0.5], solver="band"), ValueError,
+          r"^solver: the band solver needs the continuous-time grid")

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "lptv/band_lu.hpp"
 #include "lptv/model.hpp"
 #include "lptv/sparse_lu.hpp"
 
@@ -37,23 +38,29 @@ cd line_power(const Model& m, const Grid& g, int line, int n);
 SpMat build_A(const Model& m, const Grid& g);
 SpMat build_B(const Model& m, const Grid& g);
 
+// (B U) on the grid without forming B: only the nonzero rows of U cost anything.
+Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& U);
+
 // One factorisation of A on a fixed grid, reused for any number of inputs.
 class Fds {
  public:
   // Continuous time: grid -L..L (L >= 0). Discrete time: L is ignored (the grid is
-  // the model's circular one). Throws NumericalError when A is singular.
+  // the model's circular one). Throws NumericalError when A is singular, and
+  // std::invalid_argument for the band solver on the circular grid.
   Fds(const Model& m, int L, Solver solver = Solver::Auto);
   const Grid& grid() const { return grid_; }
-  Solver solver() const { return lu_->solver(); }
-  double rcond() const { return lu_->rcond(); }
+  Solver solver() const { return solver_; }
+  double rcond() const { return band_ ? band_->rcond() : lu_->rcond(); }
   // Full-grid input spectra (grid.N rows, any number of columns) -> output spectra.
   Eigen::MatrixXcd solve_full(const Eigen::MatrixXcd& U) const;
   // Columns of the harmonic transfer function G = A^-1 B for the given input lines.
   Eigen::MatrixXcd htf_columns(const std::vector<int>& input_lines) const;
 
  private:
+  Model model_;
   Grid grid_;
-  SpMat B_;
+  Solver solver_;
+  std::unique_ptr<BandLU> band_;
   std::unique_ptr<SparseLU> lu_;
 };
 
@@ -61,10 +68,12 @@ struct SimulateOptions {
   Solver solver = Solver::Auto;
   // Continuous time: highest output line wanted (-1: the highest input line).
   int lines_out = -1;
-  // Continuous time: fixed guard lines beyond the band (-1: adaptive, see tol).
+  // Continuous time: fixed guard lines beyond max(highest input line, lines_out)
+  // (-1: adaptive, see tol).
   int guard = -1;
-  // Adaptive guard: grow until the wanted lines change by less than tol relative
-  // to the largest output line.
+  // Adaptive guard: the grid starts at the highest nonzero input line (or lines_out when
+  // given) plus a guard, which grows until the wanted lines change by less than tol
+  // relative to the largest output line; lines beyond the grid are returned as zero.
   double tol = 1e-13;
   int max_guard = -1;  // -1: max(1024, 4 * band)
 };

@@ -11,13 +11,15 @@
 
 namespace lptv {
 
-enum class Solver { Auto, KLU, UMFPACK };
+// Auto: Band on the continuous-time grid (A is banded), KLU on the circular discrete-time
+// grid (the band wraps around the corners). Band is continuous time only.
+enum class Solver { Auto, KLU, UMFPACK, Band };
 
-// "klu" / "umfpack" / "auto"; throws std::invalid_argument on anything else.
+// "auto" / "band" / "klu" / "umfpack"; throws std::invalid_argument on anything else.
 Solver solver_from_string(const std::string& name);
 std::string solver_name(Solver s);
-// The backend Auto resolves to (see bench/RESULTS.md for the measurement behind it).
-Solver default_solver();
+// The backend Auto resolves to on a grid (see bench/RESULTS.md for the measurements).
+Solver default_solver(bool circular_grid);
 
 class SparseLU {
  public:
