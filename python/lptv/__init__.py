@@ -14,6 +14,7 @@ from ._core import NumericalError
 from .fds import SimulationResult, TruncationWarning, band_matrices, htf, simulate
 from .data import FrequencyData
 from .identify import IdentifiabilityWarning, IdentificationResult, identify
+from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import Multisine, multisine, spectrum, time_signal
@@ -23,5 +24,5 @@ __version__ = "0.1.0"
 __all__ = [
     "FrequencyData", "IdentifiabilityWarning", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
     "band_matrices", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
-    "identify", "normalized_residue", "multisine", "simulate", "spectrum", "time_signal",
+    "identify", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
 ]

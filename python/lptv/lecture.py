@@ -466,7 +466,7 @@ def _report(out, seed, P, ls, meas, mc, summary, kt):
     ax2.semilogy(L / T0, np.abs(d.Y[L]), ".", ms=4, label="|X_l|, mean of the periods")
     ax2.semilogy(L / T0, np.sqrt(d.varY[L]), "-", color="C3", lw=1, label="its noise std")
     ax2.axvspan(EXCITED[0] / T0, EXCITED[-1] / T0, color="C2", alpha=0.1, label="excited band")
-    ax2.axvline(CUTOFF_HZ, color="k", lw=1, ls=":", label=f"(a)'s cut-off")
+    ax2.axvline(CUTOFF_HZ, color="k", lw=1, ls=":", label="(a)'s cut-off")
     ax2.set_xlabel("frequency (Hz)"), ax2.set_ylabel("position (m)")
     ax2.grid(True, alpha=0.3), ax2.legend(fontsize="small")
     rep.figure(ax1.figure, "fig2_smd_measurement.png",

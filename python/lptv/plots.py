@@ -118,16 +118,35 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
 
 
 def coefficients(t, true=None, est=None, *, names=None, ax=None):
-    """Coefficient trajectories a_n(t) / b_m(t) over time, true and estimated."""
+    """Coefficient trajectories a_n(t) / b_m(t) over time, true (wide, pale) and estimated (dashed)."""
     ax = _axes(ax)
-    for arr, ls, lab in ((true, "-", "true"), (est, "--", "estimated")):
+    styles = {"true": dict(ls="-", lw=3.0, alpha=0.35), "estimated": dict(ls="--", lw=1.2)}
+    for arr, lab in ((true, "true"), (est, "estimated")):
         if arr is None:
             continue
         arr = np.asarray(arr)
         for j in range(arr.shape[1]):
             name = names[j] if names else f"c{j}"
-            ax.plot(t, arr[:, j], ls, color=f"C{j}", label=f"{name} {lab}")
+            ax.plot(t, arr[:, j], color=f"C{j}", label=f"{name} {lab}", **styles[lab])
     ax.set_xlabel("time (s)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def model_fit(lines, Y, Y_model, noise_std=None, *, w0=None, ax=None):
+    """Measured output spectrum, the model's output, their difference and the noise level (dB)."""
+    ax = _axes(ax)
+    lines = np.asarray(lines)
+    x = lines * w0 if w0 else lines
+    Y, Y_model = np.asarray(Y), np.asarray(Y_model)
+    ax.plot(x, _db(Y), ".", ms=3, label="measured output |Y| (mean of the periods)")
+    ax.plot(x, _db(Y_model), "x", ms=3, label="model output from the measured input")
+    ax.plot(x, _db(Y - Y_model), ".", ms=3, label="difference Y - Y_model")
+    if noise_std is not None:
+        ax.plot(x, _db(noise_std), "-", label="noise std of the mean output")
+    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_ylabel("amplitude (dB)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     return ax
