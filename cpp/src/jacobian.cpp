@@ -291,6 +291,33 @@ Eigen::VectorXd residue_variance(const FrequencyData& d, const Parametrisation& 
   return v;
 }
 
+Eigen::MatrixXcd residue_variance_gradient(const FrequencyData& d, const Parametrisation& p,
+                                           const std::vector<int>& rows, const Eigen::VectorXcd& theta) {
+  const detail::Lines X{d};
+  Eigen::MatrixXcd G(rows.size(), p.n_theta());
+  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
+    detail::RowPowers pw(p.structure());
+    const int K = pw.K();
+    std::vector<cd> A, B;
+    for (size_t r = begin; r < end; ++r) {
+      pw.compute(rows[r]);
+      band_row(p, theta, pw, A, B);
+      for (int q = 0; q < p.n_theta(); ++q) {
+        const Param& pr = p.params()[q];
+        const int i = rows[r] - pr.k;
+        // dJ = f dX with f = +s^n (a) or -s^n (b); sum_q f_q theta_q over the harmonic's
+        // group is A_li on the Y side and -B_li on the U side.
+        const cd SY = A[K + pr.k], SU = -B[K + pr.k];
+        const cd f = (pr.is_a ? 1.0 : -1.0) * pw(pr.k, pr.order);
+        const cd e = pr.is_a ? X.varY(i) * SY + std::conj(X.covYU(i)) * SU
+                             : X.covYU(i) * SY + X.varU(i) * SU;
+        G(static_cast<Eigen::Index>(r), q) = std::conj(f) * e;
+      }
+    }
+  });
+  return G;
+}
+
 Eigen::MatrixXcd column_covariance(const FrequencyData& d, const Parametrisation& p,
                                    const std::vector<int>& rows, const Eigen::VectorXd& weights) {
   if (weights.size() != static_cast<Eigen::Index>(rows.size())) {

@@ -71,6 +71,8 @@ void bind_identify(py::module_& m) {
   m.def("jacobian", &lptv::jacobian, "data"_a, "par"_a, "rows"_a);
   m.def("residue", &lptv::residue, "data"_a, "par"_a, "rows"_a, "theta"_a);
   m.def("residue_variance", &lptv::residue_variance, "data"_a, "par"_a, "rows"_a, "theta"_a);
+  m.def("residue_variance_gradient", &lptv::residue_variance_gradient, "data"_a, "par"_a, "rows"_a,
+        "theta"_a);
   m.def("column_covariance", &lptv::column_covariance, "data"_a, "par"_a, "rows"_a, "weights"_a);
   m.def("real_column_covariance", &lptv::real_column_covariance, "data"_a, "par"_a, "rows"_a,
         "weights"_a);

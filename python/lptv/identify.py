@@ -13,7 +13,7 @@ from .data import FrequencyData
 from .model import Model
 from .validation import expected_fraction_above_0db
 
-METHODS = ("ls", "tls", "gtls", "wgtls")
+METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -56,6 +56,16 @@ class IdentificationResult:
     """The data carried no noise, so GTLS/WGTLS reduced to TLS."""
     warnings: Tuple[str, ...] = field(default_factory=tuple)
     data: Optional[FrequencyData] = field(default=None, repr=False)
+    eta_names: Tuple[str, ...] = field(default_factory=tuple)
+    """Names of the entries of ``eta``, e.g. 'a0.re1' (Re of harmonic 1 of a_0)."""
+    covariance: Optional[np.ndarray] = field(default=None, repr=False)
+    """SML: covariance of ``eta`` from the cost's Jacobian (zero row and column for the
+    normalised parameter); None for the other methods."""
+
+    @property
+    def parameter_std(self) -> Optional[np.ndarray]:
+        """SML: standard deviation of each entry of ``eta`` (None for the other methods)."""
+        return None if self.covariance is None else np.sqrt(np.diag(self.covariance))
 
     @property
     def residue_ok(self) -> bool:
@@ -161,7 +171,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         Sample period of a discrete-time model.
     lines : sequence of int, optional
         The rows (lines) of the fit. Default: K+1 .. Lmax-K, K the largest harmonic count.
-    method : {'ls', 'tls', 'gtls', 'wgtls'}
+    method : {'ls', 'tls', 'gtls', 'wgtls', 'sml'}
+        'sml' refines the WGTLS estimate by Levenberg-Marquardt on the sample maximum
+        likelihood cost and gives the parameter covariance (``res.covariance``).
     known : dict, optional
         Coefficients known exactly, e.g. ``{'a2': 1.5}`` (a constant) or a Fourier row of
         2K+1 values. With a known coefficient no normalisation is applied.
@@ -213,8 +225,24 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     rows = _rows(lines, par, data)
     par.check_rows(rows, data.max_line)
 
-    r = _core.estimate(data._cpp, par, rows, method=method, tol=float(tol), max_iter=int(max_iter))
+    r = _core.estimate(data._cpp, par, rows, method="wgtls" if method == "sml" else method,
+                       tol=float(tol), max_iter=int(max_iter))
     theta = np.asarray(r["theta"])
+    covariance = None
+    if method == "sml" and not r["noise_free"]:
+        from .sml import sml_refine
+
+        fit = sml_refine(data, par, rows, theta, periods=data.periods, tol=float(tol),
+                         max_iter=int(max_iter))
+        theta = fit.theta
+        n_eta = par.n_eta
+        covariance = np.zeros((n_eta, n_eta))
+        idx = fit.free[fit.free < n_eta]
+        sel = np.isin(fit.free, idx)
+        covariance[np.ix_(idx, idx)] = fit.covariance_xi[np.ix_(sel, sel)]
+        eta = fit.xi[:n_eta]
+        r = dict(r, theta=theta, eta=eta, iterations=fit.iterations, converged=fit.converged,
+                 cost=fit.cost, cost_history=[])
     model = Model._from_core(par.to_model(theta))
     e = np.asarray(_core.residue(data._cpp, par, rows, theta))
     var_e = np.asarray(_core.residue_variance(data._cpp, par, rows, theta))
@@ -226,13 +254,13 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     p_exp, band = expected_fraction_above_0db(len(rows), n_free, data.periods)
     msgs = []
     sv = np.asarray(r["singular_values"])
-    if method in ("gtls", "wgtls") and sv.size >= 2 and not r["noise_free"] and sv[1] ** 2 < 2.0 * sv[0] ** 2:
+    if method in ("gtls", "wgtls", "sml") and sv.size >= 2 and not r["noise_free"] and sv[1] ** 2 < 2.0 * sv[0] ** 2:
         msgs.append(
             f"the two smallest generalised singular values are close ({sv[0]:.3g}, {sv[1]:.3g}): "
             "the model is nearly unidentifiable; too many harmonics (a common periodic factor of "
             "numerator and denominator) or too high orders are the likely cause")
-    if method == "wgtls" and not r["converged"]:
-        msgs.append(f"WGTLS did not converge in {max_iter} iterations (tol {tol:g})")
+    if method in ("wgtls", "sml") and not r["converged"]:
+        msgs.append(f"{method.upper()} did not converge in {max_iter} iterations (tol {tol:g})")
     if r["noise_free"]:
         msgs.append("the data carry no noise (zero variances): the noise-weighted estimate reduces to TLS")
     if not positive.all():
@@ -248,4 +276,17 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         cost_history=np.asarray(r["cost_history"]), singular_values=sv, residue=e,
         residue_variance=var_e, normalized_residue=rn, fraction_above_0db=frac,
         fraction_expected=p_exp, fraction_band=band, noise_free=r["noise_free"], warnings=tuple(msgs),
-        data=data)
+        data=data, eta_names=tuple(_eta_names(na, nb, ka_l, kb_l, kn)), covariance=covariance)
+
+
+def _eta_names(na, nb, ka, kb, known):
+    fixed = {(is_a, order) for is_a, order, _ in known}
+    names = []
+    for side, counts in (("a", ka), ("b", kb)):
+        for n, K in enumerate(counts):
+            if (side == "a", n) in fixed:
+                continue
+            names.append(f"{side}{n}.re0")
+            for k in range(1, K + 1):
+                names += [f"{side}{n}.re{k}", f"{side}{n}.im{k}"]
+    return names

@@ -94,6 +94,11 @@ Eigen::VectorXcd residue(const FrequencyData& d, const Parametrisation& p, const
 Eigen::VectorXd residue_variance(const FrequencyData& d, const Parametrisation& p,
                                  const std::vector<int>& rows, const Eigen::VectorXcd& theta);
 
+// G[r, p] = (C_l theta)_p with C_l = E{dJ_l^H dJ_l}, so that var e_l = theta^H C_l theta and,
+// for theta = T eta + d with real eta, d var e_l / d eta = 2 Re(conj(G_l) T). O(rows x n).
+Eigen::MatrixXcd residue_variance_gradient(const FrequencyData& d, const Parametrisation& p,
+                                           const std::vector<int>& rows, const Eigen::VectorXcd& theta);
+
 // C = sum_l w_l E{dJ_l^H dJ_l} (n_theta x n_theta, complex Hermitian); only entries of
 // parameters with the same harmonic are nonzero: O(rows x n x (na+nb+2)).
 Eigen::MatrixXcd column_covariance(const FrequencyData& d, const Parametrisation& p,
