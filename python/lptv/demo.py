@@ -157,7 +157,8 @@ def run(args) -> int:
     # --- Monte Carlo ---
     mc = None
     if args.monte_carlo:
-        mc = _monte_carlo(model, data, args.monte_carlo, seed, P, kw)
+        runs = min(args.monte_carlo, 5) if getattr(args, "quick", False) else args.monte_carlo
+        mc = _monte_carlo(model, data, runs, seed, P, kw)
         summary["monte_carlo"] = mc
 
     # --- report ---
