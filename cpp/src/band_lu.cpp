@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "lptv/errors.hpp"
-#include "lptv/sparse_lu.hpp"
 
 extern "C" {
 // LAPACK; the trailing size_t arguments are the hidden lengths of character arguments.
@@ -14,9 +13,6 @@ void zgbtrf_(const int* m, const int* n, const int* kl, const int* ku, std::comp
 void zgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, const int* nrhs,
              const std::complex<double>* ab, const int* ldab, const int* ipiv, std::complex<double>* b,
              const int* ldb, int* info, std::size_t);
-void zgbcon_(const char* norm, const int* n, const int* kl, const int* ku, const std::complex<double>* ab,
-             const int* ldab, const int* ipiv, const double* anorm, double* rcond,
-             std::complex<double>* work, double* rwork, int* info, std::size_t);
 }
 
 namespace lptv {
@@ -27,12 +23,6 @@ BandLU::BandLU(int n, int kl, int ku, std::vector<cd> ab, const std::function<st
   if (n < 1 || ab_.size() != static_cast<size_t>(ld) * n) {
     throw std::invalid_argument("BandLU: band storage has the wrong size");
   }
-  double anorm = 0;  // 1-norm: the largest column sum
-  for (int j = 0; j < n; ++j) {
-    double s = 0;
-    for (int r = kl; r < ld; ++r) s += std::abs(ab_[r + static_cast<size_t>(j) * ld]);
-    anorm = std::max(anorm, s);
-  }
   int info = 0;
   zgbtrf_(&n_, &n_, &kl_, &ku_, ab_.data(), &ld, ipiv_.data(), &info);
   if (info < 0) throw NumericalError("band LU (zgbtrf): invalid argument " + std::to_string(-info));
@@ -41,25 +31,6 @@ BandLU::BandLU(int n, int kl, int ku, std::vector<cd> ab, const std::function<st
     std::ostringstream msg;
     msg << "A is singular at " << label(info - 1)
         << " (a zero pivot: the system has a pole on that line, or a_na(t) vanishes)";
-    throw NumericalError(msg.str());
-  }
-  std::vector<cd> work(2 * static_cast<size_t>(n));
-  std::vector<double> rwork(n);
-  zgbcon_("1", &n_, &kl_, &ku_, ab_.data(), &ld, ipiv_.data(), &anorm, &rcond_, work.data(),
-          rwork.data(), &info, 1);
-  if (info != 0) throw NumericalError("band LU condition estimate (zgbcon) failed");
-  if (!(rcond_ * SparseLU::kMaxCondition > 1.0)) {
-    // Where: the solution for a right-hand side of unit-modulus entries peaks on the line
-    // where A is nearly singular.
-    Eigen::VectorXcd b(n);
-    for (int i = 0; i < n; ++i) b[i] = std::polar(1.0, 2.399963229728653 * i);
-    const Eigen::VectorXcd x = solve(b);
-    Eigen::Index where = 0;
-    x.cwiseAbs().maxCoeff(&where);
-    std::ostringstream msg;
-    msg << "A is numerically singular near " << label(static_cast<int>(where))
-        << " (condition number about " << 1.0 / rcond_
-        << "): a pole on or next to that line, or a_na(t) nearly vanishes";
     throw NumericalError(msg.str());
   }
 }

@@ -126,6 +126,38 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   } else {
     lu_ = std::make_unique<SparseLU>(build_A(m, grid_), solver_, label);
   }
+  // Conditioning with respect to the coefficients: a right-hand side of unit phases scaled by
+  // the magnitude of the terms in each row. An entry that cancels to rounding level (a pole
+  // on a grid line up to rounding) makes the solution huge exactly there; a large but
+  // accurately computed entry (high frequencies, high orders) does not.
+  const int K = m.ka(), na = m.na();
+  Eigen::VectorXd mag = Eigen::VectorXd::Zero(grid_.N);
+  for (int j = 0; j < grid_.N; ++j) {
+    const double w = std::abs(line_power(m, grid_, grid_.line_of(j), 1));
+    for (int k = -K; k <= K; ++k) {
+      const int row = grid_.index_of(grid_.line_of(j) + k);
+      if (row < 0) continue;
+      double t = 0, wn = 1;
+      for (int n = 0; n <= na; ++n, wn *= w) t += std::abs(m.a()(n, K + k)) * wn;
+      mag[row] += t;
+    }
+  }
+  Eigen::VectorXcd b(grid_.N);
+  for (int i = 0; i < grid_.N; ++i) b[i] = mag[i] * std::polar(1.0, 2.399963229728653 * i);  // golden angle
+  const Eigen::VectorXcd x = solve_A(b);
+  Eigen::Index where = 0;
+  condition_ = x.cwiseAbs().maxCoeff(&where);
+  if (!(condition_ < kMaxCondition)) {
+    std::ostringstream msg;
+    msg << "A is numerically singular near " << label(static_cast<int>(where))
+        << " (condition number with respect to the coefficients above " << condition_
+        << "): a pole on or next to that line, or a_na(t) nearly vanishes";
+    throw NumericalError(msg.str());
+  }
+}
+
+Eigen::MatrixXcd Fds::solve_A(const Eigen::MatrixXcd& rhs) const {
+  return band_ ? band_->solve(rhs) : lu_->solve(rhs);
 }
 
 Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
@@ -133,8 +165,7 @@ Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
     throw std::invalid_argument("U must have " + std::to_string(grid_.N) +
                                 " rows (the grid), got " + std::to_string(U.rows()));
   }
-  const Eigen::MatrixXcd rhs = apply_B(model_, grid_, U);
-  return band_ ? band_->solve(rhs) : lu_->solve(rhs);
+  return solve_A(apply_B(model_, grid_, U));
 }
 
 Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {

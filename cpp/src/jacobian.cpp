@@ -243,26 +243,37 @@ void band_row(const Parametrisation& p, const Eigen::VectorXcd& theta, const det
   }
 }
 
+// Calls f(r, pw, A, B) for every row r with the row's powers and band entries, on up to
+// two threads (f writes only to row r's outputs).
+template <class F>
+void for_each_row(const Parametrisation& p, const std::vector<int>& rows, const Eigen::VectorXcd& theta,
+                  F&& f) {
+  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
+    detail::RowPowers pw(p.structure());
+    std::vector<cd> A, B;
+    for (size_t r = begin; r < end; ++r) {
+      pw.compute(rows[r]);
+      band_row(p, theta, pw, A, B);
+      f(r, pw, A, B);
+    }
+  });
+}
+
 }  // namespace
 
 Eigen::VectorXcd residue(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
                          const Eigen::VectorXcd& theta) {
   const detail::Lines X{d};
   Eigen::VectorXcd e(rows.size());
-  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
-    detail::RowPowers pw(p.structure());
-    const int K = pw.K();
-    std::vector<cd> A, B;
-    for (size_t r = begin; r < end; ++r) {
-      pw.compute(rows[r]);
-      band_row(p, theta, pw, A, B);
-      cd v(0.0, 0.0);
-      for (int k = -K; k <= K; ++k) {
-        const int i = rows[r] - k;
-        v += A[K + k] * X.Y(i) - B[K + k] * X.U(i);
-      }
-      e[r] = v;
+  const int K = p.structure().kmax();
+  for_each_row(p, rows, theta, [&](size_t r, const detail::RowPowers&, const std::vector<cd>& A,
+                                   const std::vector<cd>& B) {
+    cd v(0.0, 0.0);
+    for (int k = -K; k <= K; ++k) {
+      const int i = rows[r] - k;
+      v += A[K + k] * X.Y(i) - B[K + k] * X.U(i);
     }
+    e[r] = v;
   });
   return e;
 }
@@ -271,22 +282,17 @@ Eigen::VectorXd residue_variance(const FrequencyData& d, const Parametrisation& 
                                  const std::vector<int>& rows, const Eigen::VectorXcd& theta) {
   const detail::Lines X{d};
   Eigen::VectorXd v(rows.size());
-  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
-    detail::RowPowers pw(p.structure());
-    const int K = pw.K();
-    std::vector<cd> A, B;
-    for (size_t r = begin; r < end; ++r) {
-      pw.compute(rows[r]);
-      band_row(p, theta, pw, A, B);
-      double s = 0;
-      for (int k = -K; k <= K; ++k) {
-        const int i = rows[r] - k;
-        const cd a = A[K + k], b = B[K + k];
-        s += std::norm(a) * X.varY(i) + std::norm(b) * X.varU(i) -
-             2.0 * (a * std::conj(b) * X.covYU(i)).real();
-      }
-      v[r] = s;
+  const int K = p.structure().kmax();
+  for_each_row(p, rows, theta, [&](size_t r, const detail::RowPowers&, const std::vector<cd>& A,
+                                   const std::vector<cd>& B) {
+    double s = 0;
+    for (int k = -K; k <= K; ++k) {
+      const int i = rows[r] - k;
+      const cd a = A[K + k], b = B[K + k];
+      s += std::norm(a) * X.varY(i) + std::norm(b) * X.varU(i) -
+           2.0 * (a * std::conj(b) * X.covYU(i)).real();
     }
+    v[r] = s;
   });
   return v;
 }
@@ -295,24 +301,19 @@ Eigen::MatrixXcd residue_variance_gradient(const FrequencyData& d, const Paramet
                                            const std::vector<int>& rows, const Eigen::VectorXcd& theta) {
   const detail::Lines X{d};
   Eigen::MatrixXcd G(rows.size(), p.n_theta());
-  detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
-    detail::RowPowers pw(p.structure());
-    const int K = pw.K();
-    std::vector<cd> A, B;
-    for (size_t r = begin; r < end; ++r) {
-      pw.compute(rows[r]);
-      band_row(p, theta, pw, A, B);
-      for (int q = 0; q < p.n_theta(); ++q) {
-        const Param& pr = p.params()[q];
-        const int i = rows[r] - pr.k;
-        // dJ = f dX with f = +s^n (a) or -s^n (b); sum_q f_q theta_q over the harmonic's
-        // group is A_li on the Y side and -B_li on the U side.
-        const cd SY = A[K + pr.k], SU = -B[K + pr.k];
-        const cd f = (pr.is_a ? 1.0 : -1.0) * pw(pr.k, pr.order);
-        const cd e = pr.is_a ? X.varY(i) * SY + std::conj(X.covYU(i)) * SU
-                             : X.covYU(i) * SY + X.varU(i) * SU;
-        G(static_cast<Eigen::Index>(r), q) = std::conj(f) * e;
-      }
+  const int K = p.structure().kmax();
+  for_each_row(p, rows, theta, [&](size_t r, const detail::RowPowers& pw, const std::vector<cd>& A,
+                                   const std::vector<cd>& B) {
+    for (int q = 0; q < p.n_theta(); ++q) {
+      const Param& pr = p.params()[q];
+      const int i = rows[r] - pr.k;
+      // dJ = f dX with f = +s^n (a) or -s^n (b); sum_q f_q theta_q over the harmonic's
+      // group is A_li on the Y side and -B_li on the U side.
+      const cd SY = A[K + pr.k], SU = -B[K + pr.k];
+      const cd f = (pr.is_a ? 1.0 : -1.0) * pw(pr.k, pr.order);
+      const cd e = pr.is_a ? X.varY(i) * SY + std::conj(X.covYU(i)) * SU
+                           : X.covYU(i) * SY + X.varU(i) * SU;
+      G(static_cast<Eigen::Index>(r), q) = std::conj(f) * e;
     }
   });
   return G;

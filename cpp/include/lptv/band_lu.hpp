@@ -15,20 +15,17 @@ class BandLU {
   using cd = std::complex<double>;
   // A (n x n) in LAPACK band storage with kl sub- and ku super-diagonals:
   // ab[(kl + ku + i - j) + j * ldab] = A(i, j), ldab = 2 kl + ku + 1 (the first kl rows are
-  // workspace for the pivoting). Throws NumericalError when A is singular (naming
-  // index_label(column)) or its condition number exceeds kMaxCondition.
+  // workspace for the pivoting). Throws NumericalError when A is exactly singular (naming
+  // index_label(column)); how well conditioned A is, the caller judges (Fds does).
   BandLU(int n, int kl, int ku, std::vector<cd> ab, const std::function<std::string(int)>& index_label);
   static int ldab(int kl, int ku) { return 2 * kl + ku + 1; }
 
   Eigen::MatrixXcd solve(const Eigen::MatrixXcd& rhs) const;
-  // LAPACK's 1-norm reciprocal condition estimate.
-  double rcond() const { return rcond_; }
 
  private:
   int n_, kl_, ku_;
   std::vector<cd> ab_;
   std::vector<int> ipiv_;
-  double rcond_ = 0.0;
 };
 
 }  // namespace lptv

@@ -24,10 +24,8 @@ Solver default_solver(bool circular_grid);
 class SparseLU {
  public:
   using SpMat = Eigen::SparseMatrix<std::complex<double>, Eigen::ColMajor, int>;
-  // Factorises A. Throws NumericalError when A is singular (naming the column as
-  // index_label(col)) or numerically singular (a condition number above kMaxCondition,
-  // estimated from below by one solve, naming where the solution peaks).
-  static constexpr double kMaxCondition = 1e13;
+  // Factorises A. Throws NumericalError when A is exactly singular (naming the column as
+  // index_label(col)); how well conditioned A is, the caller judges (Fds does).
   SparseLU(const SpMat& A, Solver solver, const std::function<std::string(int)>& index_label);
   ~SparseLU();
   SparseLU(const SparseLU&) = delete;
@@ -35,18 +33,15 @@ class SparseLU {
 
   Eigen::MatrixXcd solve(const Eigen::MatrixXcd& rhs) const;
   Solver solver() const { return solver_; }
-  // Crude reciprocal condition estimate min|U_kk| / max|U_kk|.
+  // KLU: its crude reciprocal condition estimate min|U_kk| / max|U_kk| of the row-scaled
+  // matrix; UMFPACK: 0 (not computed).
   double rcond() const { return rcond_; }
-  // Lower bound on the infinity-norm condition number of A.
-  double condition_bound() const { return cond_bound_; }
 
  private:
-  Eigen::MatrixXcd solve_unchecked(const Eigen::MatrixXcd& rhs) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Solver solver_;
   double rcond_ = 0.0;
-  double cond_bound_ = 0.0;
 };
 
 }  // namespace lptv
