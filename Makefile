@@ -82,7 +82,7 @@ bench: deps-bench python
 	$(CMAKE) --build $(BUILDROOT)/bench -j $(JOBS)
 	$(MAKE) --no-print-directory -C . bench-run
 
-# Runs the built benchmarks (2 to 4 minutes on 2 cores); every output is also kept in
+# Runs the built benchmarks (3 to 4 minutes on 2 cores); every output is also kept in
 # $(BENCH_OUT) for bench/RESULTS.md. Smaller runs: make bench BENCH_MAX_LINES=1000000.
 BENCH_BIN := $(BUILDROOT)/bench/bench/cpp
 BENCH_OUT := $(BUILDROOT)/bench/results
@@ -92,9 +92,14 @@ BENCH_PY_MAX_LINES ?= 1000000
 bench-run:
 	@mkdir -p $(BENCH_OUT)
 	@echo "machine: $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), load average $$(cut -d' ' -f1-3 /proc/loadavg)" | tee $(BENCH_OUT)/machine.txt
+	@echo "commit: $$(git rev-parse --short HEAD)$$(git diff --quiet HEAD -- cpp python CMakeLists.txt || echo ' (with uncommitted changes in cpp/, python/ or CMakeLists.txt)')" | tee -a $(BENCH_OUT)/machine.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_fds_cvode 1 | tee $(BENCH_OUT)/fds_cvode.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_fds_scaling $(BENCH_MAX_LINES) | tee $(BENCH_OUT)/fds_scaling.txt
 	set -o pipefail; $(PY) bench/python/bench_simulate.py $(BENCH_PY_MAX_LINES) | tee $(BENCH_OUT)/simulate.txt
+	set -o pipefail; ./$(BENCH_BIN)/bench_wgtls | tee $(BENCH_OUT)/wgtls.txt
+	set -o pipefail; $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py.txt
+	set -o pipefail; OPENBLAS_NUM_THREADS=1 $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py_1thread.txt
+	@echo "load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg)" | tee -a $(BENCH_OUT)/machine.txt
 
 clean:
 	rm -rf $(BUILDROOT)

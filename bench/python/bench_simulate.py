@@ -3,22 +3,27 @@
 The paper-like model (METHOD.md section 8, K = 3: 7 diagonals) and a random-phase input on
 every line 0..L; the output on lines 0..L. The routes:
 
-- ``simulate``: lptv.simulate as a user calls it (adaptive guard: two or more factorisations);
-- ``simulate/g``: lptv.simulate with the guard the adaptive run ended with (one factorisation);
+- ``simulate``: lptv.simulate as a user calls it (solver 'auto', adaptive guard: two or more
+  factorisations);
+- ``sim/g``: lptv.simulate with the guard the adaptive run ended with (one factorisation);
+- ``klu``, ``klu/g``: the same two with solver='klu';
 - ``banded``: the same grid -(L+g)..L+g solved with scipy.linalg.solve_banded, A in LAPACK band
   storage built from model.a in NumPy (building A and B U is timed as well);
-- ``dense``: numpy.linalg.solve on the dense A (lptv.reference when present), small L only.
+- ``dense``: numpy.linalg.solve on the dense A (lptv.reference.simulate), small L only.
 
 Every call is timed whole (Python overhead included); the routes take turns, and each one's
-fastest round is reported (the least disturbed by other work on the machine). The routes
-must agree to 1e-10 of the output peak (asserted): all solve the same linear system, A is
-diagonally dominant (harmonics below 40 % of the DC coefficient in every row), so their
-difference is rounding.
+fastest round is reported (the least disturbed by other work on the machine). A route whose
+first call takes more than 2 s is timed by that call alone, and a route is not run at the next
+L when its time, extrapolated with the growth seen between the last two L, would exceed
+BUDGET_S. The routes must agree to 1e-10 of the output peak (asserted): all solve the same
+linear system, A is diagonally dominant (harmonics below 40 % of the DC coefficient in every
+row), so their difference is rounding.
 
 Usage: python bench_simulate.py [max_lines]   (default 10^6)
 """
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -27,16 +32,12 @@ from scipy.linalg import solve_banded
 
 import lptv
 import lptv.examples as ex
-
-try:
-    from lptv.reference import simulate as dense_simulate
-    DENSE_SOURCE = "lptv.reference.simulate"
-except ImportError:  # the NumPy reference is optional here
-    dense_simulate = None
-    DENSE_SOURCE = "inline dense solve"
+from lptv.reference import simulate as dense_simulate
 
 AGREE = 1e-10
 DENSE_MAX_LINES = 1000
+SLOW_S = 2.0      # a first call slower than this is the route's only call at that L
+BUDGET_S = 120.0  # skip a route whose extrapolated call would take longer
 
 
 def _powers(model, lines, order):
@@ -72,90 +73,115 @@ def banded_route(model, U, guard):
     return Y[L:L + Lu + 1]
 
 
-def dense_route(model, U, guard):
-    if dense_simulate is not None:
-        return dense_simulate(model, U, guard=guard)
-    Lu = U.size - 1
-    L = Lu + guard
-    n = 2 * L + 1
-    lines = np.arange(-L, L + 1)
-    K = model.ka
-    pa = _powers(model, lines, model.na)
-    A = np.zeros((n, n), complex)
-    for k in range(-K, K + 1):
-        v = model.a[:, K + k] @ pa
-        i = np.arange(max(0, -k), min(n, n - k))
-        A[i + k, i] = v[i]
-    Kb = model.kb
-    pb = _powers(model, lines, model.nb)
-    B = np.zeros((n, n), complex)
-    for k in range(-Kb, Kb + 1):
-        v = model.b[:, Kb + k] @ pb
-        i = np.arange(max(0, -k), min(n, n - k))
-        B[i + k, i] = v[i]
-    F = np.zeros(n, complex)
-    F[L:L + Lu + 1] = U
-    F[L - Lu:L] = np.conj(U[:0:-1])
-    F[L] = U[0].real
-    return np.linalg.solve(A, B @ F)[L:L + Lu + 1]
+class Route:
+    def __init__(self, name, make):
+        self.name, self.make = name, make  # make(U, guard) -> callable returning Y
+        self.history = []                  # (L, seconds) of the sizes run
+
+    def predicted(self, L):
+        """The time at L extrapolated from the last two sizes (t ~ L^p), None without two."""
+        if len(self.history) < 2:
+            return None
+        (L1, t1), (L2, t2) = self.history[-2:]
+        p = max(1.0, math.log(t2 / t1) / math.log(L2 / L1))
+        return t2 * (L / L2) ** p
 
 
-def timed(routes, reps):
-    """Minimum wall time of each callable over `reps` rounds, and its result.
+def timed(calls, reps):
+    """Fastest wall time of each callable over `reps` interleaved rounds, and its result.
 
-    The routes take turns within each round, so that a change of the machine's load
-    affects them alike; the minimum is the least disturbed run (the machine is shared)."""
-    out = [f() for f in routes]  # warm-up, also the results that are compared
-    t = np.full((reps, len(routes)), np.inf)
-    for r in range(reps):
-        for i, f in enumerate(routes):
+    The first call of each is the warm-up and gives the result that is compared; a callable
+    whose first call took more than SLOW_S seconds keeps that time and is not repeated."""
+    out, t, slow = [], np.full(len(calls), np.inf), []
+    for i, f in enumerate(calls):
+        t0 = time.perf_counter()
+        out.append(f())
+        first = time.perf_counter() - t0
+        slow.append(first > SLOW_S)
+        if slow[i]:
+            t[i] = first
+    for _ in range(reps):
+        for i, f in enumerate(calls):
+            if slow[i]:
+                continue
             t0 = time.perf_counter()
             f()
-            t[r, i] = time.perf_counter() - t0
-    return t.min(axis=0), out
+            t[i] = min(t[i], time.perf_counter() - t0)
+    return t, out
 
 
 def main(max_lines: int = 10**6):
     model = ex.paper_model()
     rng = np.random.default_rng(0)
-    print(f"lptv.simulate vs scipy.linalg.solve_banded vs dense ({DENSE_SOURCE}); paper-like "
-          f"model, input on every line 0..L, output lines 0..L; minimum wall times over interleaved rounds, calls whole")
-    print(f"default solver: {lptv.simulate(model, np.ones(3), full_output=True).solver}\n")
-    head = (f"{'L':>8} {'guard':>5} {'simulate':>10} {'simulate/g':>10} {'banded':>10} "
-            f"{'dense':>10} {'sim/banded':>10} {'sim/g/band':>10} {'dense/sim':>10} {'max diff':>9}")
+    solver = lptv.simulate(model, np.ones(3), full_output=True).solver
+    print("lptv.simulate vs scipy.linalg.solve_banded vs dense (lptv.reference.simulate); "
+          "paper-like model, input on every line 0..L, output lines 0..L")
+    print(f"solver 'auto' picks: {solver}; sim = lptv.simulate (adaptive guard), sim/g = fixed "
+          "guard g (the adaptive run's), klu = solver='klu'")
+    print(f"fastest of interleaved rounds, calls timed whole; a route slower than {SLOW_S:g} s "
+          f"is timed by one call, one predicted above {BUDGET_S:g} s is not run\n")
+    routes = [
+        Route("sim", lambda U, g: (lambda: lptv.simulate(model, U))),
+        Route("sim/g", lambda U, g: (lambda: lptv.simulate(model, U, guard=g))),
+        Route("klu", lambda U, g: (lambda: lptv.simulate(model, U, solver="klu"))),
+        Route("klu/g", lambda U, g: (lambda: lptv.simulate(model, U, guard=g, solver="klu"))),
+        Route("banded", lambda U, g: (lambda: banded_route(model, U, g))),
+        Route("dense", lambda U, g: (lambda: dense_simulate(model, U, guard=g))),
+    ]
+    head = f"{'L':>8} {'guard':>5}" + "".join(f" {r.name:>10}" for r in routes) + \
+        f" {'sim/band':>9} {'sim/g/band':>10} {'klu/band':>9} {'klu/g/band':>10} {'max diff':>9}"
     print(head)
     L = 1000
+    skipped = []
     while L <= max_lines:
         U = np.exp(2j * np.pi * rng.uniform(size=L + 1)) / np.sqrt(L)
         U[0] = U[0].real
+        g = lptv.simulate(model, U, full_output=True, solver="klu").guard
+        active = []
+        for r in routes:
+            pred = r.predicted(L)
+            if r.name == "dense" and L > DENSE_MAX_LINES:
+                continue
+            if pred is not None and pred > BUDGET_S:
+                (L1, t1), (L2, t2) = r.history[-2:]
+                skipped.append(f"{r.name} at L = {L}: extrapolated {pred:.0f} s per call "
+                               f"(t ~ L^{math.log(t2 / t1) / math.log(L2 / L1):.1f} from L = "
+                               f"{L1} to {L2})")
+            else:
+                active.append(r)
         reps = int(max(5, min(15, 3e5 / L))) if L < 10**6 else 3
-        g = lptv.simulate(model, U, full_output=True).guard
-        (t_sim, t_simg, t_band), (r, Yg, Yb) = timed(
-            [lambda: lptv.simulate(model, U, full_output=True),
-             lambda: lptv.simulate(model, U, guard=g),
-             lambda: banded_route(model, U, g)], reps)
-        results = [r.Y, Yg, Yb]
-        t_dense = np.nan
-        if L <= DENSE_MAX_LINES:
-            (t_dense,), (Yd,) = timed([lambda: dense_route(model, U, g)], 1)
-            results.append(Yd)
+        t, results = timed([r.make(U, g) for r in active], reps)
+        times = {}
+        for r, ti in zip(active, t):
+            r.history.append((L, ti))
+            times[r.name] = ti
+        Yb = results[[r.name for r in active].index("banded")]
         peak = np.abs(Yb).max()
         diff = max(np.abs(Y - Yb).max() for Y in results) / peak
         assert diff <= AGREE, f"routes disagree at L = {L}: {diff:.1e}"
-        print(f"{L:>8} {g:>5} {1e3 * t_sim:>8.2f}ms {1e3 * t_simg:>8.2f}ms "
-              f"{1e3 * t_band:>8.2f}ms {1e3 * t_dense:>8.1f}ms {t_sim / t_band:>10.2f} "
-              f"{t_simg / t_band:>10.2f} {t_dense / t_sim:>10.0f} {diff:>9.1e}")
+
+        def cell(name):
+            return f"{1e3 * times[name]:>8.2f}ms" if name in times else f"{'-':>10}"
+
+        def ratio(name, width):
+            return f"{times[name] / times['banded']:>{width}.2f}" if name in times else f"{'-':>{width}}"
+
+        print(f"{L:>8} {g:>5}" + "".join(f" {cell(r.name)}" for r in routes) +
+              f" {ratio('sim', 9)} {ratio('sim/g', 10)} {ratio('klu', 9)} {ratio('klu/g', 10)}"
+              f" {diff:>9.1e}", flush=True)
         L *= 10
+    for s in skipped:
+        print(f"not run: {s}")
     # The fixed cost of one call: a tiny system, where the solve itself is negligible.
     U = np.zeros(11, complex)
     U[10] = 0.5
     g = lptv.simulate(model, U, full_output=True).guard
-    (t_small, t_small_g, t_small_b), _ = timed(
-        [lambda: lptv.simulate(model, U), lambda: lptv.simulate(model, U, guard=g),
-         lambda: banded_route(model, U, g)], 200)
-    print(f"\ncall overhead, L = 10 (guard {g}): simulate {1e6 * t_small:.0f} us, simulate/g "
-          f"{1e6 * t_small_g:.0f} us, banded {1e6 * t_small_b:.0f} us")
-    print("ratios > 1 mean lptv.simulate is slower; goal: sim/banded <= 1 at L = 10^5")
+    t, _ = timed([lambda: lptv.simulate(model, U), lambda: lptv.simulate(model, U, guard=g),
+                  lambda: banded_route(model, U, g)], 200)
+    print(f"\ncall overhead, L = 10 (guard {g}): sim {1e6 * t[0]:.0f} us, sim/g {1e6 * t[1]:.0f} us, "
+          f"banded {1e6 * t[2]:.0f} us")
+    print("ratios > 1 mean lptv.simulate is slower than solve_banded; goal: sim/band <= 1 at "
+          "L = 10^5 (the default solver)")
 
 
 if __name__ == "__main__":

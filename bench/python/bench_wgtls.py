@@ -1,0 +1,116 @@
+"""WGTLS of the C++ core against the NumPy reference, on the paper-like example, side by side.
+
+The data are the demo's measurements (``lptv.demo.paper_measurements(seed, periods=8)``:
+8 noisy periods of N = 2048 samples); the model na = 2, nb = 1, 3 harmonics on every
+coefficient (35 free real parameters); rows = lines 1..243; WGTLS to tol = 1e-12. The routes:
+
+- ``identify``: ``lptv.identify(u, y, ...)`` as a user calls it - spectra and noise statistics
+  from the periods, the estimate, then the residue, its variance and the validation figures;
+- ``core``: ``lptv._core.estimate`` on data and a parametrisation built beforehand (the
+  compiled estimator alone, no Python around it);
+- ``reference``: ``lptv.reference.identification`` from the periods - ``frequency_data``,
+  ``Parametrisation``, ``estimate`` (the same stopping rule as the core);
+- ``ref est``: its ``estimate`` alone, on data built beforehand.
+
+The two pairs compared are identify vs reference (whole calls from the periods) and core vs
+ref est (the estimator alone). The routes take turns in each round and each one's fastest
+round counts (the least disturbed by other work on the machine). Both must give the same
+estimate: theta to 1e-9 relative (asserted). Their iteration counts are shown (C++/reference):
+the change of theta that stops WGTLS falls below 1e-12 within rounding of the tolerance, so
+they may differ by one.
+
+NumPy's BLAS (the reference's) and the system OpenBLAS (the core's) each keep a pool of
+threads that spin for a while after a call; on a machine with few cores the two pools interleaved
+slow the reference down. ``make bench`` runs this script twice, as is and with
+OPENBLAS_NUM_THREADS=1 (the reference's faster setting here).
+
+Usage: python bench_wgtls.py [seeds]   (default 3: seeds 1..3)
+"""
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import numpy as np
+
+import lptv
+from lptv import _core
+from lptv.data import FrequencyData
+from lptv.demo import paper_measurements
+from lptv.reference import identification as ref
+
+NA, NB, K = 2, 1, 3
+LINES = range(1, 244)
+TOL = 1e-12
+AGREE = 1e-9
+ROUNDS = 7
+
+
+def routes(u, y, w0):
+    rows = list(LINES)
+    core_data = FrequencyData.from_periods(u, y, w0=w0)
+    core_par = _core.Parametrisation(NA, NB, [K] * (NA + 1), [K] * (NB + 1), [], w0, 0.0)
+    ref_data = ref.frequency_data(u, y)
+    ref_par = ref.Parametrisation(NA, NB, [K] * (NA + 1), [K] * (NB + 1), w0=w0)
+
+    def identify():
+        r = lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, method="wgtls",
+                          tol=TOL)
+        return np.asarray(r.theta), r.iterations
+
+    def core():
+        r = _core.estimate(core_data._cpp, core_par, rows, method="wgtls", tol=TOL, max_iter=50)
+        return np.asarray(r["theta"]), r["iterations"]
+
+    def reference():
+        data = ref.frequency_data(u, y)
+        par = ref.Parametrisation(NA, NB, [K] * (NA + 1), [K] * (NB + 1), w0=w0)
+        r = ref.estimate(data, par, np.asarray(rows), method="wgtls", tol=TOL)
+        return r["theta"], r["iterations"]
+
+    def ref_est():
+        r = ref.estimate(ref_data, ref_par, np.asarray(rows), method="wgtls", tol=TOL)
+        return r["theta"], r["iterations"]
+
+    return {"identify": identify, "core": core, "reference": reference, "ref est": ref_est}
+
+
+def main(n_seeds: int = 3):
+    print("WGTLS, C++ core vs NumPy reference (lptv.reference.identification), paper-like example")
+    print(f"data: lptv.demo.paper_measurements(seed, periods=8); na={NA}, nb={NB}, ka=kb={K} "
+          f"(35 parameters), lines {LINES.start}..{LINES.stop - 1}, tol={TOL:g}")
+    print(f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', '(unset: one thread per core)')}"
+          " - NumPy's BLAS threads (the core's own BLAS runs single-threaded at this size)")
+    print(f"times: the fastest of {ROUNDS} interleaved rounds, calls timed whole; "
+          "reference/identify and ref est/core are the ratios (goal: >= 20x)\n")
+    print(f"{'seed':>4} {'iter':>5} {'identify':>10} {'core':>10} {'reference':>10} {'ref est':>10} "
+          f"{'ref/identify':>12} {'ref est/core':>12} {'theta diff':>10}")
+    ratios_whole, ratios_core = [], []
+    for seed in range(1, n_seeds + 1):
+        m = paper_measurements(seed, periods=8)
+        fns = routes(m["u"], m["y"], m["w0"])
+        results = {name: f() for name, f in fns.items()}  # warm-up, and the results compared
+        theta0 = results["identify"][0]
+        diff = max(np.linalg.norm(th - theta0) / np.linalg.norm(theta0) for th, _ in results.values())
+        assert diff <= AGREE, f"seed {seed}: the estimates differ by {diff:.1e}"
+        its = f"{results['core'][1]}/{results['ref est'][1]}"
+        best = {name: np.inf for name in fns}
+        for _ in range(ROUNDS):
+            for name, f in fns.items():
+                t0 = time.perf_counter()
+                f()
+                best[name] = min(best[name], time.perf_counter() - t0)
+        rw = best["reference"] / best["identify"]
+        rc = best["ref est"] / best["core"]
+        ratios_whole.append(rw)
+        ratios_core.append(rc)
+        print(f"{seed:>4} {its:>5} " + " ".join(f"{1e3 * best[n]:>8.2f}ms" for n in fns) +
+              f" {rw:>11.1f}x {rc:>11.1f}x {diff:>10.1e}", flush=True)
+    print(f"\nreference / C++ (goal: >= 20x): {min(ratios_whole):.1f}x .. {max(ratios_whole):.1f}x "
+          f"with lptv.identify, {min(ratios_core):.1f}x .. {max(ratios_core):.1f}x with "
+          f"_core.estimate alone")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
