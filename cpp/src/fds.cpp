@@ -131,14 +131,18 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   // on a grid line up to rounding) makes the solution huge exactly there; a large but
   // accurately computed entry (high frequencies, high orders) does not.
   const int K = m.ka(), na = m.na();
+  const Eigen::MatrixXd absa = m.a().cwiseAbs();  // |a_{n,k}|, once
   Eigen::VectorXd mag = Eigen::VectorXd::Zero(grid_.N);
+  std::vector<double> wn(na + 1);
   for (int j = 0; j < grid_.N; ++j) {
     const double w = std::abs(line_power(m, grid_, grid_.line_of(j), 1));
+    wn[0] = 1.0;
+    for (int n = 1; n <= na; ++n) wn[n] = wn[n - 1] * w;
     for (int k = -K; k <= K; ++k) {
       const int row = grid_.index_of(grid_.line_of(j) + k);
       if (row < 0) continue;
-      double t = 0, wn = 1;
-      for (int n = 0; n <= na; ++n, wn *= w) t += std::abs(m.a()(n, K + k)) * wn;
+      double t = 0;
+      for (int n = 0; n <= na; ++n) t += absa(n, K + k) * wn[n];
       mag[row] += t;
     }
   }
