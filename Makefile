@@ -42,12 +42,17 @@ deps:
 deps-bench: deps
 	$(call apt_install,$(APT_BENCH))
 
-$(VENV)/.pins: Makefile
+# The stamp's name carries a hash of the pins: changing a pin reinstalls, editing the rest of
+# this file does not.
+PINS_STAMP := $(VENV)/.pins-$(shell echo '$(PIP_PINS)' | md5sum | cut -c1-12)
+
+$(PINS_STAMP):
 	@test -x $(PY) || python3 -m venv $(VENV)
-	$(PIP) install -q --disable-pip-version-check $(PIP_PINS)
+	@rm -f $(VENV)/.pins-*
+	$(PIP) install -qq --disable-pip-version-check $(PIP_PINS)
 	@touch $@
 
-venv: $(VENV)/.pins
+venv: $(PINS_STAMP)
 
 cpp: deps venv
 	$(CMAKE) -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=ON \
