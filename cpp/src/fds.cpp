@@ -277,6 +277,8 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
   struct Run {
     Eigen::MatrixXcd Y;
     double bound;
+    double edge;  // outermost K lines relative to the peak
+    double cond;
   };
   auto run = [&](int band_lines, int guard) {
     Fds fds(m, band_lines + guard, opt.solver);
@@ -288,7 +290,8 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     for (int l = std::max(0, L - K + 1); l <= L; ++l) {
       edge = std::max(edge, full.row(fds.grid().index_of(l)).cwiseAbs().maxCoeff());
     }
-    return Run{to_onesided(fds.grid(), full, lines_out), 10.0 * std::max(1.0, fds.condition()) * edge / peak};
+    const double cond = std::max(1.0, fds.condition());
+    return Run{to_onesided(fds.grid(), full, lines_out), 10.0 * cond * edge / peak, edge / peak, cond};
   };
   if (m.kmax() == 0) {
     // LTI: A is diagonal, lines do not couple, no truncation error.
@@ -319,8 +322,19 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     res.converged = true;
     return res;
   }
+  const int excited = last_nonzero_line(U);
   while (true) {
-    const int next = 2 * guard;
+    // The output decays about geometrically beyond the last excited line: from the edge
+    // value at distance D, the distance where the bound meets tol, with a margin.
+    int next = 2 * guard;
+    const int D = band + guard - excited;
+    if (prev.edge > 0 && prev.edge < 1 && D > 0) {
+      const double need = D * std::log(opt.tol / (10.0 * prev.cond)) / std::log(prev.edge);
+      if (std::isfinite(need)) {
+        next = std::max(next, static_cast<int>(std::min(1.25 * need, 1e9)) - (band - excited));
+      }
+    }
+    next = std::min(next, std::max(max_guard, 2 * guard));
     Run cur = run(band, next);
     const double peak = std::max(cur.Y.cwiseAbs().maxCoeff(), 1e-300);
     const double diff = (cur.Y - prev.Y).cwiseAbs().maxCoeff() / peak;
