@@ -17,8 +17,9 @@ import pytest
 import lptv
 import lptv.examples as ex
 from lptv import _core
-# The reference package does not re-export this module; import it by its full name.
+# The identification reference, by its full name.
 from lptv.reference import identification as ref
+from conftest import _coefficient_row  # the random stable coefficient rows the FDS tests use
 
 METHODS = ["ls", "tls", "gtls", "wgtls"]
 SEEDS = [0, 1, 2]
@@ -30,19 +31,6 @@ MAX_ITER = 100
 
 
 # ------------------------------------------------------------------------------- test problems
-
-def _coefficient_row(rng, dc, K, depth):
-    """Harmonics -K..K around a real DC value; 2 sum_k |c_k| = depth |dc| keeps it within
-    dc (1 +- depth) at all times."""
-    row = np.zeros(2 * K + 1, complex)
-    row[K] = dc
-    if K:
-        c = rng.normal(size=K) + 1j * rng.normal(size=K)
-        c *= depth * abs(dc) / (2 * np.abs(c).sum())
-        row[K + 1:] = c
-        row[:K] = np.conj(c[::-1])
-    return row
-
 
 def _pad(row, K):
     k = (row.size - 1) // 2
