@@ -201,11 +201,7 @@ def _read_npz(path, periods):
             arrays = {k: npz[k] for k in ("u", "y", "w0") if k in npz.files}
         except Exception as e:
             raise FileError(f"cannot read as NPZ: {_one_line(e)}") from None
-    for name in ("u", "y"):
-        if name not in arrays:
-            raise FileError(f"array '{name}' is missing (the file has {', '.join(npz.files) or 'none'})")
-    return (_as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods),
-            _file_w0(arrays.get("w0")))
+    return _u_y_w0(arrays, npz.files, periods, "array")
 
 
 def _read_mat(path, periods):
@@ -220,11 +216,7 @@ def _read_mat(path, periods):
     except Exception as e:  # scipy raises a zoo of types for a damaged or foreign file
         raise FileError(f"cannot read as a MATLAB file: {_one_line(e)}") from None
     names = [k for k in d if not k.startswith("__")]
-    for name in ("u", "y"):
-        if name not in d:
-            raise FileError(f"variable '{name}' is missing (the file has {', '.join(names) or 'none'})")
-    return (_as_periods("u", d["u"], periods), _as_periods("y", d["y"], periods),
-            _file_w0(d.get("w0")), "MAT v5")
+    return (*_u_y_w0(d, names, periods, "variable"), "MAT v5")
 
 
 def _read_mat73(path, periods):
@@ -240,9 +232,14 @@ def _read_mat73(path, periods):
         raise
     except Exception as e:
         raise FileError(f"cannot read as a MATLAB v7.3 (HDF5) file: {_one_line(e)}") from None
+    return _u_y_w0(arrays, names, periods, "variable")
+
+
+def _u_y_w0(arrays, names, periods, kind):
+    """u and y as (P, N) periods and the optional w0 from what a file holds."""
     for name in ("u", "y"):
         if name not in arrays:
-            raise FileError(f"variable '{name}' is missing (the file has {', '.join(names) or 'none'})")
+            raise FileError(f"{kind} '{name}' is missing (the file has {', '.join(names) or 'none'})")
     return (_as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods),
             _file_w0(arrays.get("w0")))
 
