@@ -8,6 +8,7 @@
 
 #include "lptv/errors.hpp"
 #include "lptv/gsvd.hpp"
+#include "lptv/likelihood.hpp"
 #include "rows.hpp"
 
 extern "C" {
@@ -23,7 +24,8 @@ Method method_from_string(const std::string& name) {
   if (name == "tls") return Method::TLS;
   if (name == "gtls") return Method::GTLS;
   if (name == "wgtls") return Method::WGTLS;
-  throw std::invalid_argument("method must be 'ls', 'tls', 'gtls' or 'wgtls', got '" + name + "'");
+  if (name == "sml") return Method::SML;
+  throw std::invalid_argument("method must be 'ls', 'tls', 'gtls', 'wgtls' or 'sml', got '" + name + "'");
 }
 
 std::string method_name(Method m) {
@@ -31,6 +33,7 @@ std::string method_name(Method m) {
     case Method::LS: return "ls";
     case Method::TLS: return "tls";
     case Method::GTLS: return "gtls";
+    case Method::SML: return "sml";
     default: return "wgtls";
   }
 }
@@ -246,6 +249,20 @@ EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const 
       res.converged = true;
       break;
     }
+  }
+  if (opt.method == Method::SML) {
+    // The exact likelihood from the WGTLS estimate: WGTLS is consistent, so the start is
+    // close and the Gauss-Newton steps of the refinement are short.
+    const ExactLikelihood lik(d, p, rows);
+    const ExactFit fit = minimise_exact_cost(lik, p, res.theta, opt.tol, opt.max_iter);
+    const double scale = 1.0 / (2.0 * static_cast<double>(rows.size()));
+    res.theta = fit.theta;
+    res.eta = p.eta_from_xi(fit.xi);
+    res.iterations = fit.iterations;
+    res.converged = fit.converged;
+    res.cost = fit.cost * scale;
+    res.cost_history.clear();
+    for (double v : fit.cost_history) res.cost_history.push_back(v * scale);
   }
   return res;
 }

@@ -37,6 +37,18 @@ class RowPowers {
   std::vector<cd> pw_;
 };
 
+// A_{l,i} and B_{l,i} for i = l - k, k = -K..K (index K + k), from the row's powers.
+inline void band_row(const Parametrisation& p, const Eigen::VectorXcd& theta, const detail::RowPowers& pw,
+              std::vector<cd>& A, std::vector<cd>& B) {
+  const int K = pw.K();
+  A.assign(2 * K + 1, cd(0.0, 0.0));
+  B.assign(2 * K + 1, cd(0.0, 0.0));
+  for (int q = 0; q < p.n_theta(); ++q) {
+    const Param& pr = p.params()[q];
+    (pr.is_a ? A : B)[K + pr.k] += theta[q] * pw(pr.k, pr.order);
+  }
+}
+
 // Line values with X_{-l} = conj(X_l); the statistics of a conjugate line follow.
 struct Lines {
   const FrequencyData& d;

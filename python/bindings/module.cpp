@@ -3,7 +3,7 @@
 #include "lptv/errors.hpp"
 
 PYBIND11_MODULE(_core, m) {
-  m.doc() = "lptv compiled core: model, multisines, frequency-domain simulator";
+  m.doc() = "lptv compiled core: model, multisines, frequency-domain simulator, estimators";
   // std::invalid_argument becomes ValueError by pybind11's default translation.
   static py::exception<lptv::NumericalError> numerical_error(m, "NumericalError", PyExc_ArithmeticError);
   py::register_exception_translator([](std::exception_ptr p) {
@@ -16,5 +16,9 @@ PYBIND11_MODULE(_core, m) {
   bind_model(m);
   bind_multisine(m);
   bind_fds(m);
-  bind_identify(m);
+  bind_noise(m);
+  bind_structure(m);
+  bind_jacobian(m);
+  bind_likelihood(m);
+  bind_estimators(m);
 }

@@ -11,7 +11,7 @@ import numpy as np
 from . import _core
 from .data import FrequencyData
 from .model import Model
-from .validation import expected_fraction_above_0db
+from ._validate import as_positive_float
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 
@@ -22,7 +22,7 @@ class IdentifiabilityWarning(UserWarning):
 
 @dataclass(frozen=True)
 class IdentificationResult:
-    """What :func:`identify` returns."""
+    """What :func:`identify` returns (built from the core's ``Identification``)."""
 
     model: Model
     """The estimate, normalised so that a_{na,0} = 1 (or scaled by the known coefficients)."""
@@ -35,13 +35,15 @@ class IdentificationResult:
     """The free real parameters (Re c_0, Re c_1, Im c_1, ... per free coefficient)."""
     n_free_parameters: int
     iterations: int
-    """WGTLS: weighted solves after the GTLS start (0 for the other methods)."""
+    """WGTLS: weighted solves after the GTLS start; SML: Levenberg-Marquardt steps; 0 otherwise."""
     converged: bool
     cost: float
-    """The method's objective at the estimate (WGTLS: the smallest generalised eigenvalue)."""
+    """The method's objective at the estimate (WGTLS: the smallest generalised eigenvalue;
+    SML: V / (2 |rows|) with V the exact cost, METHOD.md eq. 17)."""
     cost_history: np.ndarray
     singular_values: np.ndarray
-    """Generalised (GTLS, WGTLS) or ordinary (TLS) singular values, ascending; empty for LS."""
+    """Generalised (GTLS, WGTLS, SML: those of the WGTLS start) or ordinary (TLS) singular values,
+    ascending; empty for LS."""
     residue: np.ndarray
     """e_l = A(theta) Y - B(theta) U on the rows."""
     residue_variance: np.ndarray
@@ -59,13 +61,47 @@ class IdentificationResult:
     eta_names: Tuple[str, ...] = field(default_factory=tuple)
     """Names of the entries of ``eta``, e.g. 'a0.re1' (Re of harmonic 1 of a_0)."""
     covariance: Optional[np.ndarray] = field(default=None, repr=False)
-    """SML: covariance of ``eta`` from the cost's Jacobian (zero row and column for the
-    normalised parameter); None for the other methods."""
+    """WGTLS and SML: covariance of ``eta`` (zero row and column for the normalised parameter),
+    corrected for noise variances estimated from the periods (see :func:`covariance_correction`);
+    None for LS, TLS and GTLS."""
+    nearly_unidentifiable: bool = False
+    """The two smallest generalised singular values are close while the residue test passes."""
 
     @property
     def parameter_std(self) -> Optional[np.ndarray]:
-        """SML: standard deviation of each entry of ``eta`` (None for the other methods)."""
+        """WGTLS, SML: standard deviation of each entry of ``eta`` (None for the other methods)."""
         return None if self.covariance is None else np.sqrt(np.diag(self.covariance))
+
+    def confidence_interval(self, level: float = 0.95) -> np.ndarray:
+        """Two-sided intervals ``eta +- z std`` for each entry of ``eta``: array (n_eta, 2).
+
+        ``z`` is the normal quantile of ``level``; the covariance is the calibrated one (the Monte
+        Carlo in bench/RESULTS.md shows their coverage). The normalised parameter has a zero-width
+        interval.
+
+        Examples
+        --------
+        >>> import numpy as np, lptv
+        >>> m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)          # 1 / (s + 2)
+        >>> ms = lptv.multisine(range(1, 60), 256, seed=0)
+        >>> y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
+        >>> rng = np.random.default_rng(1)
+        >>> u = ms.periods(8) + 1e-3 * rng.standard_normal((8, 256))
+        >>> y = np.tile(y1, (8, 1)) + 1e-3 * rng.standard_normal((8, 256))
+        >>> res = lptv.identify(u, y, na=1, nb=0, w0=0.1, method="sml")
+        >>> lo, hi = res.confidence_interval(0.95)[0]                # a0: true value 2
+        >>> bool(lo < 2.0 < hi)
+        True
+        """
+        from scipy.stats import norm
+
+        level = as_positive_float(level, "level")
+        if not 0.0 < level < 1.0:
+            raise ValueError(f"level must be in (0, 1), got {level!r}")
+        if self.covariance is None:
+            raise ValueError(f"method {self.method!r} gives no covariance: use method='wgtls' or 'sml'")
+        half = norm.ppf(0.5 + level / 2.0) * self.parameter_std
+        return np.column_stack([self.eta - half, self.eta + half])
 
     @property
     def residue_ok(self) -> bool:
@@ -82,6 +118,15 @@ class IdentificationResult:
             f"normalised residue above 0 dB: {100 * self.fraction_above_0db:.1f} % "
             f"(expected {100 * self.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %): {verdict}",
         ]
+        std = self.parameter_std
+        lines.append("parameters" + (" (+- one standard deviation)" if std is not None else "") + ":")
+        for i, name in enumerate(self.eta_names):
+            if std is None:
+                lines.append(f"  {name:10s} {self.eta[i]: .6g}")
+            elif std[i] == 0.0:
+                lines.append(f"  {name:10s} {self.eta[i]: .6g}  (normalised)")
+            else:
+                lines.append(f"  {name:10s} {self.eta[i]: .6g} +- {std[i]:.3g}")
         lines += [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
@@ -133,9 +178,7 @@ def _known_list(known, ka, kb):
     return out
 
 
-def _rows(lines, par, data):
-    if lines is None:
-        return par.default_rows(data.max_line)
+def _rows(lines):
     try:
         rows = np.asarray(list(lines) if not isinstance(lines, np.ndarray) else lines)
     except TypeError:
@@ -172,14 +215,16 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     lines : sequence of int, optional
         The rows (lines) of the fit. Default: K+1 .. Lmax-K, K the largest harmonic count.
     method : {'ls', 'tls', 'gtls', 'wgtls', 'sml'}
-        'sml' refines the WGTLS estimate by Levenberg-Marquardt on the sample maximum
-        likelihood cost and gives the parameter covariance (``res.covariance``).
+        'wgtls' is the paper's weighted GTLS; 'sml' minimises the exact likelihood of the
+        residue (METHOD.md eq. 17, rows correlated through shared lines) from the WGTLS
+        estimate. Both give the covariance of ``eta`` (``res.covariance``,
+        ``res.parameter_std``, ``res.confidence_interval()``).
     known : dict, optional
         Coefficients known exactly, e.g. ``{'a2': 1.5}`` (a constant) or a Fourier row of
         2K+1 values. With a known coefficient no normalisation is applied.
     tol, max_iter :
-        WGTLS stops when the relative change of the parameters is below ``tol`` or after
-        ``max_iter`` weighted solves (``converged`` says which).
+        WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
+        ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
 
     Examples
     --------
@@ -221,72 +266,19 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     na, nb = int(na), int(nb)
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
-    par = _core.Parametrisation(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
-    rows = _rows(lines, par, data)
-    par.check_rows(rows, data.max_line)
-
-    r = _core.estimate(data._cpp, par, rows, method="wgtls" if method == "sml" else method,
-                       tol=float(tol), max_iter=int(max_iter))
-    theta = np.asarray(r["theta"])
-    covariance = None
-    if method == "sml" and not r["noise_free"]:
-        from .sml import sml_refine
-
-        fit = sml_refine(data, par, rows, theta, periods=data.periods, tol=float(tol),
-                         max_iter=int(max_iter))
-        theta = fit.theta
-        n_eta = par.n_eta
-        covariance = np.zeros((n_eta, n_eta))
-        idx = fit.free[fit.free < n_eta]
-        sel = np.isin(fit.free, idx)
-        covariance[np.ix_(idx, idx)] = fit.covariance_xi[np.ix_(sel, sel)]
-        eta = fit.xi[:n_eta]
-        r = dict(r, theta=theta, eta=eta, iterations=fit.iterations, converged=fit.converged,
-                 cost=fit.cost, cost_history=[])
-    model = Model._from_core(par.to_model(theta))
-    e = np.asarray(_core.residue(data._cpp, par, rows, theta))
-    var_e = np.asarray(_core.residue_variance(data._cpp, par, rows, theta))
-    positive = var_e > 0
-    # Noise-free rows have no normalised residue; they are NaN, and a warning below says why.
-    rn = np.full(e.shape, np.nan)
-    rn[positive] = np.abs(e[positive]) / np.sqrt(var_e[positive])
-    n_free = par.n_xi - 1
-    p_exp, band = expected_fraction_above_0db(len(rows), n_free, data.periods)
-    msgs = []
-    sv = np.asarray(r["singular_values"])
-    if method in ("gtls", "wgtls", "sml") and sv.size >= 2 and not r["noise_free"] and sv[1] ** 2 < 2.0 * sv[0] ** 2:
-        msgs.append(
-            f"the two smallest generalised singular values are close ({sv[0]:.3g}, {sv[1]:.3g}): "
-            "the model is nearly unidentifiable; too many harmonics (a common periodic factor of "
-            "numerator and denominator) or too high orders are the likely cause")
-    if method in ("wgtls", "sml") and not r["converged"]:
-        msgs.append(f"{method.upper()} did not converge in {max_iter} iterations (tol {tol:g})")
-    if r["noise_free"]:
-        msgs.append("the data carry no noise (zero variances): the noise-weighted estimate reduces to TLS")
-    if not positive.all():
-        msgs.append(f"the residue variance is zero on {int((~positive).sum())} of {len(rows)} rows "
-                    "(no noise there): their normalised residues are NaN and the 0 dB fraction "
-                    "is taken over the other rows")
-    for msg in msgs:
-        warnings.warn(msg, IdentifiabilityWarning if "unidentifiable" in msg else UserWarning, stacklevel=2)
-    frac = float(np.mean(rn[positive] > 1.0)) if positive.any() else float("nan")
+    structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
+    rows = [] if lines is None else _rows(lines)
+    r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter), rows=rows)
+    for msg in r.warnings:
+        unident = r.nearly_unidentifiable and "unidentifiable" in msg
+        warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
+    cov = r.covariance
     return IdentificationResult(
-        model=model, method=method, lines=np.asarray(rows), theta=theta, eta=np.asarray(r["eta"]),
-        n_free_parameters=n_free, iterations=r["iterations"], converged=r["converged"], cost=r["cost"],
-        cost_history=np.asarray(r["cost_history"]), singular_values=sv, residue=e,
-        residue_variance=var_e, normalized_residue=rn, fraction_above_0db=frac,
-        fraction_expected=p_exp, fraction_band=band, noise_free=r["noise_free"], warnings=tuple(msgs),
-        data=data, eta_names=tuple(_eta_names(na, nb, ka_l, kb_l, kn)), covariance=covariance)
-
-
-def _eta_names(na, nb, ka, kb, known):
-    fixed = {(is_a, order) for is_a, order, _ in known}
-    names = []
-    for side, counts in (("a", ka), ("b", kb)):
-        for n, K in enumerate(counts):
-            if (side == "a", n) in fixed:
-                continue
-            names.append(f"{side}{n}.re0")
-            for k in range(1, K + 1):
-                names += [f"{side}{n}.re{k}", f"{side}{n}.im{k}"]
-    return names
+        model=Model._from_core(r.model), method=method, lines=np.asarray(r.rows), theta=np.asarray(r.theta),
+        eta=np.asarray(r.eta), n_free_parameters=r.n_free, iterations=r.iterations, converged=r.converged,
+        cost=r.cost, cost_history=np.asarray(r.cost_history), singular_values=np.asarray(r.singular_values),
+        residue=np.asarray(r.residue), residue_variance=np.asarray(r.residue_variance),
+        normalized_residue=np.asarray(r.normalized_residue), fraction_above_0db=r.fraction_above_0db,
+        fraction_expected=r.fraction_expected, fraction_band=tuple(r.fraction_band), noise_free=r.noise_free,
+        warnings=tuple(r.warnings), data=data, eta_names=tuple(r.eta_names),
+        covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable)

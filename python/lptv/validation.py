@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import as_real_1d
+from ._validate import as_int, as_real_1d
 from .model import Model
 
 
@@ -12,14 +12,6 @@ def _structure_of(model: Model):
     return _core.Parametrisation(model.na, model.nb, [model.ka] * (model.na + 1),
                                  [model.kb] * (model.nb + 1), [], model.w0,
                                  0.0 if model.ts is None else model.ts)
-
-
-def _theta_of(model: Model, par) -> np.ndarray:
-    theta = np.empty(par.n_theta, complex)
-    a, b = model.a, model.b
-    for i, (is_a, order, k) in enumerate(par.params):
-        theta[i] = a[order, model.ka + k] if is_a else b[order, model.kb + k]
-    return theta
 
 
 def normalized_residue(model: Model, data, lines, *, _par=None, _theta=None):
@@ -30,7 +22,7 @@ def normalized_residue(model: Model, data, lines, *, _par=None, _theta=None):
     e, var_e, r : ndarrays over the rows
     """
     par = _par if _par is not None else _structure_of(model)
-    theta = _theta if _theta is not None else _theta_of(model, par)
+    theta = _theta if _theta is not None else par.theta_from_model(model._cpp)
     rows = [int(x) for x in lines]
     par.check_rows(rows, data.max_line)
     e = np.asarray(_core.residue(data._cpp, par, rows, theta))
@@ -48,15 +40,21 @@ def expected_fraction_above_0db(n_rows: int, n_free: int, periods: int):
     (1 + 1/(P-1))^-(P-1); fitting n parameters to 2|R| real equations shrinks |e|^2 by
     c = 1 - n/(2|R|), giving P(r > 1) = (1 + 1/(c (P-1)))^-(P-1) (exp(-1/c) for known
     variances, ``periods`` = 0). The band is +-3 binomial standard deviations over the rows.
+
+    Examples
+    --------
+    >>> import lptv
+    >>> p, (lo, hi) = lptv.expected_fraction_above_0db(243, 34, 8)
+    >>> round(p, 3), round(lo, 3), round(hi, 3)
+    (0.425, 0.33, 0.52)
     """
-    c = max(1.0 - n_free / (2.0 * n_rows), 1e-6)
-    if periods and periods >= 2:
-        q = periods - 1
-        p = (1.0 + 1.0 / (c * q)) ** (-q)
-    else:
-        p = float(np.exp(-1.0 / c))
-    s = 3.0 * np.sqrt(p * (1 - p) / n_rows)
-    return p, (max(0.0, p - s), min(1.0, p + s))
+    n_rows = as_int(n_rows, "n_rows", minimum=1)
+    n_free = as_int(n_free, "n_free")
+    periods = as_int(periods, "periods")
+    if periods == 1:
+        raise ValueError("periods must be 0 (known variances) or >= 2, got 1")
+    p, band = _core.expected_fraction_above_0db(n_rows, n_free, periods)
+    return p, tuple(band)
 
 
 def _frozen_roots(coef_at, t, order, what):

@@ -1,8 +1,11 @@
-// The estimators of METHOD.md section 6: LS, TLS, GTLS and the paper's weighted GTLS
-// (eq. 14), all on the real, constrained Jacobian, all from its R factor.
+// The estimators of METHOD.md sections 6 and 10: LS, TLS, GTLS and the paper's weighted GTLS
+// (eq. 14), all on the real, constrained Jacobian from its R factor, and the sample maximum
+// likelihood on the exact cost (eq. 17). lptv::identify is the one entry point: estimate,
+// covariance, residue diagnostics and warnings.
 #pragma once
 #include <Eigen/Dense>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lptv/jacobian.hpp"
@@ -10,23 +13,25 @@
 
 namespace lptv {
 
-enum class Method { LS, TLS, GTLS, WGTLS };
+enum class Method { LS, TLS, GTLS, WGTLS, SML };
 Method method_from_string(const std::string& name);
 std::string method_name(Method m);
 
 struct EstimateOptions {
   Method method = Method::WGTLS;
-  double tol = 1e-10;   // WGTLS: relative change of theta that ends the iteration
-  int max_iter = 50;    // WGTLS: cap on the weighted solves
+  double tol = 1e-10;   // WGTLS, SML: relative change of the parameters that ends the iteration
+  int max_iter = 50;    // WGTLS: cap on the weighted solves; SML: on the Levenberg-Marquardt steps
 };
 
 struct EstimateResult {
   Eigen::VectorXcd theta;            // all complex parameters (Parametrisation order)
   Eigen::VectorXd eta;               // free real parameters
-  int iterations = 0;                // WGTLS: weighted solves after the GTLS start
+  int iterations = 0;                // WGTLS: weighted solves after the GTLS start; SML: LM steps
   bool converged = true;
-  double cost = 0;                   // the method's objective at the estimate
-  std::vector<double> cost_history;  // WGTLS: cost per iteration
+  // The method's objective at the estimate; SML: V / (2 |R|), the mean of |e_l|^2 / var e_l
+  // for uncorrelated rows.
+  double cost = 0;
+  std::vector<double> cost_history;  // WGTLS, SML: cost per iteration
   // Generalised (GTLS, WGTLS) or ordinary (TLS) singular values of the final problem,
   // ascending (empty for LS). Two close smallest ones mean a near-unidentifiable model.
   Eigen::VectorXd singular_values;
@@ -54,5 +59,55 @@ GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ);
 
 EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
                         const EstimateOptions& opt = EstimateOptions());
+
+// Fraction of normalised residues above 0 dB expected for a correct model, and a band of
+// +-3 binomial standard deviations over the rows (METHOD.md section 7).
+struct ExpectedFraction {
+  double p, lo, hi;
+};
+ExpectedFraction expected_fraction_above_0db(int n_rows, int n_free, int periods);
+
+// Factor applied to the first-order covariance of the SML and WGTLS estimates when the noise
+// (co)variances come from P periods (P = 0: known, factor 1); see identify.cpp.
+double covariance_correction(int periods);
+
+struct IdentifyOptions {
+  Method method = Method::WGTLS;
+  double tol = 1e-10;
+  int max_iter = 50;
+  std::vector<int> rows;    // lines of the fit; empty: default_rows
+  bool covariance = true;   // WGTLS, SML: compute the covariance of eta
+};
+
+struct Identification {
+  explicit Identification(Model m) : model(std::move(m)) {}
+  Model model;                        // normalised: a_{na,0} = 1 (or scaled by known coefficients)
+  Method method = Method::WGTLS;
+  std::vector<int> rows;
+  Eigen::VectorXcd theta;
+  Eigen::VectorXd eta;
+  std::vector<std::string> eta_names;
+  int n_free = 0;
+  int iterations = 0;
+  bool converged = true;
+  double cost = 0;
+  std::vector<double> cost_history;
+  Eigen::VectorXd singular_values;
+  Eigen::VectorXcd residue;           // e_l on the rows
+  Eigen::VectorXd residue_variance;   // var e_l (eq. 15)
+  Eigen::VectorXd normalized_residue; // |e_l| / sqrt(var e_l); NaN where var e_l = 0 (warned)
+  double fraction_above_0db = 0;      // over the rows with var e_l > 0
+  ExpectedFraction fraction_expected{0, 0, 0};
+  bool residue_ok = false;            // fraction_above_0db inside the expected band
+  bool nearly_unidentifiable = false; // the two smallest generalised singular values are close
+  bool noise_free = false;
+  // WGTLS (sandwich) and SML (inverse Fisher information), times covariance_correction(P):
+  // n_eta x n_eta, zero row and column for the normalised parameter; empty otherwise.
+  Eigen::MatrixXd covariance;
+  std::vector<std::string> warnings;
+};
+
+// Estimate, covariance and residue diagnostics of every method on the data (METHOD.md 5-7, 10).
+Identification identify(const FrequencyData& d, const Structure& s, const IdentifyOptions& opt = IdentifyOptions());
 
 }  // namespace lptv

@@ -1,0 +1,95 @@
+// The exact errors-in-variables likelihood of the residue for LPTV rows (METHOD.md
+// section 10): the banded residue covariance S = M Cov(n) M^T (eq. 16), the cost
+// V = r^T S^{-1} r (eq. 17), its exact gradient, the Fisher information and the
+// Cramer-Rao bound.
+#pragma once
+#include <Eigen/Dense>
+#include <vector>
+
+#include "lptv/noise.hpp"
+#include "lptv/structure.hpp"
+
+namespace lptv {
+
+// The likelihood of one data set on one set of rows. Rows are taken in ascending order
+// (rows l and l' share noisy lines only when |l - l'| <= 2K, so S is banded in that order);
+// every per-row output below is in the caller's order.
+//
+// Real residue r = [Re e_l, Im e_l] per row; real noise n = [Re dY_m, Im dY_m, Re dU_m,
+// Im dU_m] per measured line m >= 0 (DC: real parts only). r = M(theta) x with x the
+// measured spectra in the layout of n, so dV/dxi_j = 2 q^T M_j x0 with q = S^{-1} r and
+// x0 = x - Cov(n) M^T q, the data nearest to x that the model explains exactly (the
+// noiseless spectra the likelihood eliminates). The whitened Jacobian L^{-1} M_j x0 thus
+// gives the exact gradient and the Gauss-Newton (Fisher) approximation of the Hessian.
+class ExactLikelihood {
+ public:
+  ExactLikelihood(const FrequencyData& d, const Parametrisation& p, std::vector<int> rows);
+
+  struct Evaluation {
+    double cost = 0;             // V = r^T S^{-1} r
+    Eigen::VectorXd whitened;    // w = L^{-1} r (S = L L^T), sorted-row order; V = |w|^2
+    Eigen::VectorXd gradient;    // dV/dxi over all n_xi entries of xi (theta = Text xi)
+    Eigen::MatrixXd jacobian;    // L^{-1} dr/dxi at x0 (sorted-row order), all n_xi columns
+    FrequencyData denoised;      // x0 as spectra (lines the rows do not use: as measured)
+  };
+
+  // The cost alone (one banded Cholesky).
+  double cost(const Eigen::VectorXcd& theta) const;
+  // Cost, gradient and whitened Jacobian. Throws NumericalError when S is not positive
+  // definite (rows whose lines carry no noise), naming the row.
+  Evaluation evaluate(const Eigen::VectorXcd& theta) const;
+
+  // F = J^T S^{-1} J over the free entries of xi (Parametrisation::free_indices), J = dr/dxi
+  // at x0 (at the data themselves when they are noiseless: then F^{-1} is the Cramer-Rao bound).
+  Eigen::MatrixXd fisher_information(const Eigen::VectorXcd& theta) const;
+
+  // Sandwich covariance of the free entries of xi for an estimator whose estimating equation
+  // is J^T W (M x) = 0 with the real row weights W = diag(w_l, w_l): H^{-1} J^T W S W J H^{-1},
+  // H = J^T W J, J = dr/dxi at x0 (the weighted GTLS of eq. 14 to first order in the noise).
+  Eigen::MatrixXd sandwich_covariance(const Eigen::VectorXcd& theta, const Eigen::VectorXd& weights) const;
+
+  // S in dense form, sorted-row order (for tests and small problems).
+  Eigen::MatrixXd residue_covariance(const Eigen::VectorXcd& theta) const;
+
+  const std::vector<int>& sorted_rows() const { return sorted_; }
+  // order()[i]: position in the caller's rows of sorted row i.
+  const std::vector<int>& order() const { return order_; }
+  int half_bandwidth() const { return kd_; }
+
+ private:
+  struct Factor;  // the banded Cholesky factor of S and the per-entry blocks
+  Factor factor(const Eigen::VectorXcd& theta) const;
+  Eigen::MatrixXd real_jacobian(const FrequencyData& x) const;  // dr/dxi, sorted-row order
+
+  FrequencyData d_;
+  Parametrisation p_;
+  std::vector<int> sorted_, order_;
+  int K_ = 0, kd_ = 0;
+};
+
+// Levenberg-Marquardt on V over the free entries of xi from theta0 (normalised first), with
+// the exact gradient and the Gauss-Newton Hessian of the whitened residue. Converged: the
+// relative step fell below tol, or no step lowers V any more (a minimum to rounding).
+struct ExactFit {
+  Eigen::VectorXcd theta;
+  Eigen::VectorXd xi;
+  double cost = 0;                   // V at the estimate
+  std::vector<double> cost_history;  // V after each accepted step
+  int iterations = 0;
+  bool converged = false;
+  Eigen::MatrixXd information;       // J^T S^{-1} J over the free entries at the estimate
+};
+ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
+                             const Eigen::VectorXcd& theta0, double tol, int max_iter);
+
+// The Cramer-Rao bound of eta for a design: `noiseless` holds the true spectra U, Y and the
+// true (co)variances of the noise on them; theta the true parameters. n_eta x n_eta, zero row
+// and column for the normalised parameter.
+Eigen::MatrixXd cramer_rao_bound(const FrequencyData& noiseless, const Parametrisation& p,
+                                 const std::vector<int>& rows, const Eigen::VectorXcd& theta);
+
+// A covariance of the free entries of xi (free_indices order) placed into eta coordinates:
+// n_eta x n_eta, zero row and column for the normalised parameter.
+Eigen::MatrixXd eta_covariance(const Parametrisation& p, const Eigen::MatrixXd& cov_free);
+
+}  // namespace lptv

@@ -1,0 +1,402 @@
+#include "lptv/likelihood.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include "lptv/errors.hpp"
+#include "lptv/jacobian.hpp"
+#include "rows.hpp"
+
+namespace lptv {
+
+namespace {
+
+// Real 2 x 4 map of one band entry (coefficient a on Y_i, -b on U_i) onto [Re e, Im e] from
+// the noise of physical line m = |i| in the layout [Re Y, Im Y, Re U, Im U]. A conjugate
+// line (i < 0) enters through conj(X_m). At DC the imaginary parts carry no noise (their
+// covariance is zero) but the map keeps them, so that r = M x equals the complex residue
+// even for a DC line with a (rounding-level) imaginary part.
+void entry_map(cd a, cd b, bool conjugate, double G[2][4]) {
+  const cd c[2] = {a, -b};
+  for (int s = 0; s < 2; ++s) {
+    const double re = c[s].real(), im = c[s].imag();
+    double* g0 = &G[0][2 * s];
+    double* g1 = &G[1][2 * s];
+    if (!conjugate) {  // c (x + j y)
+      g0[0] = re; g0[1] = -im;
+      g1[0] = im; g1[1] = re;
+    } else {  // c (x - j y)
+      g0[0] = re; g0[1] = im;
+      g1[0] = im; g1[1] = -re;
+    }
+  }
+}
+
+// Cov(n_m), 4 x 4 (METHOD.md section 10).
+void line_covariance(const FrequencyData& d, int m, double C[4][4]) {
+  const double cy = d.varY[m], cu = d.varU[m];
+  const cd c = d.covYU[m];
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) C[i][j] = 0.0;
+  if (m == 0) {  // real line: full variances on the real parts
+    C[0][0] = cy;
+    C[2][2] = cu;
+    C[0][2] = C[2][0] = c.real();
+    return;
+  }
+  C[0][0] = C[1][1] = 0.5 * cy;
+  C[2][2] = C[3][3] = 0.5 * cu;
+  C[0][2] = C[2][0] = C[1][3] = C[3][1] = 0.5 * c.real();  // E{ReY ReU} = E{ImY ImU}
+  C[1][2] = C[2][1] = 0.5 * c.imag();                      // E{ImY ReU}
+  C[0][3] = C[3][0] = -0.5 * c.imag();                     // E{ReY ImU}
+}
+
+}  // namespace
+
+// Per sorted row r and harmonic k (index r * (2K+1) + K + k): the physical line, the map G
+// and H = Cov(n_m) G^T; the lower band of L (S = L L^T) column by column, Lb(i - j, j).
+struct ExactLikelihood::Factor {
+  struct Entry {
+    int m;
+    double G[2][4];
+    double H[4][2];
+  };
+  std::vector<Entry> e;
+  Eigen::MatrixXd Lb;
+  Eigen::VectorXd r;  // the real residue, sorted-row order
+};
+
+ExactLikelihood::ExactLikelihood(const FrequencyData& d, const Parametrisation& p, std::vector<int> rows)
+    : d_(d), p_(p) {
+  d_.validate();
+  check_rows(p_, rows, d_.max_line());
+  order_.resize(rows.size());
+  std::iota(order_.begin(), order_.end(), 0);
+  std::sort(order_.begin(), order_.end(), [&](int a, int b) { return rows[a] < rows[b]; });
+  sorted_.resize(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) sorted_[i] = rows[order_[i]];
+  K_ = p_.structure().kmax();
+  // Sorted rows i < j share a line only if rows[j] - rows[i] <= 2K (or, through a conjugate
+  // line, rows[i] + rows[j] <= 2K, which implies it): j - i <= 2K, 2 real rows each.
+  kd_ = 2 * (2 * K_) + 1;
+}
+
+ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) const {
+  if (theta.size() != p_.n_theta()) throw std::invalid_argument("theta has the wrong size");
+  const int R = static_cast<int>(sorted_.size()), W = 2 * K_ + 1, n = 2 * R;
+  Factor f;
+  f.e.resize(static_cast<size_t>(R) * W);
+  f.r = Eigen::VectorXd::Zero(n);
+  const detail::Lines X{d_};
+  detail::RowPowers pw(p_.structure());
+  std::vector<cd> A, B;
+  for (int r = 0; r < R; ++r) {
+    pw.compute(sorted_[r]);
+    detail::band_row(p_, theta, pw, A, B);
+    for (int k = -K_; k <= K_; ++k) {
+      const int i = sorted_[r] - k;
+      Factor::Entry& en = f.e[static_cast<size_t>(r) * W + K_ + k];
+      en.m = std::abs(i);
+      entry_map(A[K_ + k], B[K_ + k], i < 0, en.G);
+      double C[4][4];
+      line_covariance(d_, en.m, C);
+      for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 2; ++c) {
+          double s = 0;
+          for (int b = 0; b < 4; ++b) s += C[a][b] * en.G[c][b];
+          en.H[a][c] = s;
+        }
+      const cd v = A[K_ + k] * X.Y(i) - B[K_ + k] * X.U(i);
+      f.r[2 * r] += v.real();
+      f.r[2 * r + 1] += v.imag();
+    }
+  }
+  // S in lower band storage: block (r, r') for r' = r..r+2K, from the entries of both rows
+  // on the same physical line (row r' uses line m directly at k' = l' - m, and through its
+  // conjugate at k' = l' + m).
+  f.Lb = Eigen::MatrixXd::Zero(kd_ + 1, n);
+  for (int r = 0; r < R; ++r) {
+    for (int r2 = r; r2 < std::min(R, r + 2 * K_ + 1); ++r2) {
+      double blk[2][2] = {{0, 0}, {0, 0}};
+      for (int k = -K_; k <= K_; ++k) {
+        const Factor::Entry& a = f.e[static_cast<size_t>(r) * W + K_ + k];
+        for (int sgn = 0; sgn < 2; ++sgn) {
+          if (sgn == 1 && a.m == 0) break;
+          const int k2 = sorted_[r2] + (sgn == 0 ? -1 : 1) * a.m;
+          if (std::abs(k2) > K_) continue;
+          const Factor::Entry& b = f.e[static_cast<size_t>(r2) * W + K_ + k2];
+          if (b.m != a.m) continue;
+          for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j) {
+              double s = 0;
+              for (int c = 0; c < 4; ++c) s += a.G[i][c] * b.H[c][j];
+              blk[i][j] += s;
+            }
+        }
+      }
+      // Entries (2r + i, 2r2 + j) with 2r2 + j >= 2r + i go to the lower band at (row 2r2 + j,
+      // column 2r + i), by symmetry.
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+          const int col = 2 * r + i, row = 2 * r2 + j;
+          if (row >= col) f.Lb(row - col, col) = blk[i][j];
+        }
+    }
+  }
+  // Banded Cholesky in place: O(n kd^2).
+  const double smax = f.Lb.row(0).maxCoeff();
+  for (int j = 0; j < n; ++j) {
+    double djj = f.Lb(0, j);
+    for (int k = std::max(0, j - kd_); k < j; ++k) djj -= f.Lb(j - k, k) * f.Lb(j - k, k);
+    if (!(djj > 1e-13 * smax) || !std::isfinite(djj)) {
+      const int row = sorted_[j / 2];
+      throw NumericalError("the residue covariance is singular at row (line) " + std::to_string(row) +
+                           ": the lines it uses carry (almost) no noise, so the likelihood is undefined"
+                           " (use method='wgtls')");
+    }
+    const double ljj = std::sqrt(djj);
+    f.Lb(0, j) = ljj;
+    for (int i = j + 1; i <= std::min(n - 1, j + kd_); ++i) {
+      double s = f.Lb(i - j, j);
+      for (int k = std::max(0, i - kd_); k < j; ++k) s -= f.Lb(i - k, k) * f.Lb(j - k, k);
+      f.Lb(i - j, j) = s / ljj;
+    }
+  }
+  return f;
+}
+
+namespace {
+
+// X <- L^{-1} X, L lower banded (Lb(i - j, j)), column by column of X.
+void forward_solve(const Eigen::MatrixXd& Lb, int kd, Eigen::Ref<Eigen::MatrixXd> X) {
+  const Eigen::Index n = Lb.cols();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    X.row(j) /= Lb(0, j);
+    const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd);
+    for (Eigen::Index i = j + 1; i <= last; ++i) X.row(i) -= Lb(i - j, j) * X.row(j);
+  }
+}
+
+// x <- L^{-T} x.
+void backward_solve(const Eigen::MatrixXd& Lb, int kd, Eigen::VectorXd& x) {
+  const Eigen::Index n = Lb.cols();
+  for (Eigen::Index j = n - 1; j >= 0; --j) {
+    double s = x[j];
+    const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd);
+    for (Eigen::Index i = j + 1; i <= last; ++i) s -= Lb(i - j, j) * x[i];
+    x[j] = s / Lb(0, j);
+  }
+}
+
+}  // namespace
+
+double ExactLikelihood::cost(const Eigen::VectorXcd& theta) const {
+  Factor f = factor(theta);
+  forward_solve(f.Lb, kd_, f.r);
+  return f.r.squaredNorm();
+}
+
+Eigen::MatrixXd ExactLikelihood::real_jacobian(const FrequencyData& x) const {
+  // dr/dxi = [Re; Im] of J Text, rows interleaved; J[l, q] = +-s^n X_{l-k}.
+  const detail::Lines X{x};
+  const Eigen::MatrixXcd& T = p_.Text();
+  const int R = static_cast<int>(sorted_.size());
+  Eigen::MatrixXd out(2 * R, p_.n_xi());
+  detail::RowPowers pw(p_.structure());
+  Eigen::RowVectorXcd j(p_.n_theta());
+  for (int r = 0; r < R; ++r) {
+    pw.compute(sorted_[r]);
+    for (int q = 0; q < p_.n_theta(); ++q) {
+      const Param& pr = p_.params()[q];
+      const int i = sorted_[r] - pr.k;
+      j[q] = pw(pr.k, pr.order) * (pr.is_a ? X.Y(i) : -X.U(i));
+    }
+    const Eigen::RowVectorXcd jt = j * T;
+    out.row(2 * r) = jt.real();
+    out.row(2 * r + 1) = jt.imag();
+  }
+  return out;
+}
+
+ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Eigen::VectorXcd& theta) const {
+  const Factor f = factor(theta);
+  Evaluation ev;
+  ev.whitened = f.r;
+  forward_solve(f.Lb, kd_, ev.whitened);
+  ev.cost = ev.whitened.squaredNorm();
+  Eigen::VectorXd q = ev.whitened;
+  backward_solve(f.Lb, kd_, q);
+  // x0 = x - Cov(n) M^T q, line by line over the entries that touch each line.
+  ev.denoised = d_;
+  std::vector<std::array<double, 4>> z(d_.max_line() + 1, {0.0, 0.0, 0.0, 0.0});
+  const int R = static_cast<int>(sorted_.size()), W = 2 * K_ + 1;
+  std::vector<char> touched(d_.max_line() + 1, 0);
+  for (int r = 0; r < R; ++r)
+    for (int k = 0; k < W; ++k) {
+      const Factor::Entry& en = f.e[static_cast<size_t>(r) * W + k];
+      for (int a = 0; a < 4; ++a) z[en.m][a] += en.H[a][0] * q[2 * r] + en.H[a][1] * q[2 * r + 1];
+      touched[en.m] = 1;
+    }
+  for (int m = 0; m <= d_.max_line(); ++m) {
+    if (!touched[m]) continue;
+    ev.denoised.Y[m] -= cd(z[m][0], z[m][1]);
+    ev.denoised.U[m] -= cd(z[m][2], z[m][3]);
+  }
+  ev.jacobian = real_jacobian(ev.denoised);
+  forward_solve(f.Lb, kd_, ev.jacobian);
+  ev.gradient = 2.0 * ev.jacobian.transpose() * ev.whitened;
+  return ev;
+}
+
+namespace {
+
+Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J, const std::vector<int>& free) {
+  Eigen::MatrixXd out(J.rows(), static_cast<Eigen::Index>(free.size()));
+  for (size_t c = 0; c < free.size(); ++c) out.col(static_cast<Eigen::Index>(c)) = J.col(free[c]);
+  return out;
+}
+
+Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& F, const char* what) {
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(F);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
+    throw NumericalError(std::string(what) + " is singular: the parameters are not identifiable "
+                         "from these data (too many harmonics or orders, or too few excited lines)");
+  }
+  const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
+  return 0.5 * (inv + inv.transpose());
+}
+
+}  // namespace
+
+Eigen::MatrixXd ExactLikelihood::fisher_information(const Eigen::VectorXcd& theta) const {
+  const Evaluation ev = evaluate(theta);
+  const Eigen::MatrixXd Jw = free_columns(ev.jacobian, p_.free_indices());
+  return Jw.transpose() * Jw;
+}
+
+Eigen::MatrixXd ExactLikelihood::sandwich_covariance(const Eigen::VectorXcd& theta,
+                                                     const Eigen::VectorXd& weights) const {
+  const int R = static_cast<int>(sorted_.size());
+  if (weights.size() != R) throw std::invalid_argument("weights must have one entry per row");
+  const Evaluation ev = evaluate(theta);
+  Factor f = factor(theta);
+  Eigen::MatrixXd J = free_columns(real_jacobian(ev.denoised), p_.free_indices());
+  for (int r = 0; r < R; ++r) J.middleRows(2 * r, 2) *= weights[order_[r]];  // W J
+  // J^T W S W J = (L^T W J)^T (L^T W J): L^T applied to each column from the band.
+  const Eigen::Index n = 2 * R;
+  Eigen::MatrixXd LtWJ = Eigen::MatrixXd::Zero(n, J.cols());
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd_);
+    for (Eigen::Index i = j; i <= last; ++i) LtWJ.row(j) += f.Lb(i - j, j) * J.row(i);
+  }
+  const Eigen::MatrixXd meat = LtWJ.transpose() * LtWJ;
+  // H = J^T W J = (W J)^T J with the unweighted J: divide the weights back out.
+  Eigen::MatrixXd J1 = J;
+  for (int r = 0; r < R; ++r) J1.middleRows(2 * r, 2) /= weights[order_[r]];
+  const Eigen::MatrixXd Hinv = symmetric_inverse(J.transpose() * J1, "the weighted information matrix");
+  const Eigen::MatrixXd cov = Hinv * meat * Hinv;
+  return 0.5 * (cov + cov.transpose());
+}
+
+ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
+                             const Eigen::VectorXcd& theta0, double tol, int max_iter) {
+  const std::vector<int> free = p.free_indices();
+  const int nf = static_cast<int>(free.size());
+  ExactFit fit;
+  fit.xi = p.xi_from_theta(theta0);
+  fit.theta = p.theta_from_xi(fit.xi);
+  fit.xi = p.xi_from_theta(fit.theta);  // normalised
+  ExactLikelihood::Evaluation ev = lik.evaluate(fit.theta);
+  auto half_gradient = [&](const ExactLikelihood::Evaluation& e, Eigen::MatrixXd& J) {
+    J = free_columns(e.jacobian, free);
+    return Eigen::VectorXd(J.transpose() * e.whitened);
+  };
+  Eigen::MatrixXd J;
+  Eigen::VectorXd g = half_gradient(ev, J);
+  double lambda = 1e-3;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  for (int it = 1; it <= max_iter; ++it) {
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd D = H.diagonal().cwiseMax(kEps * H.diagonal().maxCoeff());
+    bool accepted = false;
+    Eigen::VectorXd step, xi_t;
+    Eigen::VectorXcd theta_t;
+    ExactLikelihood::Evaluation ev_t;
+    while (lambda < 1e12) {
+      Eigen::MatrixXd Hl = H;
+      Hl.diagonal() += lambda * D;
+      step = Hl.ldlt().solve(-g);
+      xi_t = fit.xi;
+      for (int c = 0; c < nf; ++c) xi_t[free[c]] += step[c];
+      try {
+        theta_t = p.theta_from_xi(xi_t);
+        ev_t = lik.evaluate(theta_t);
+      } catch (const NumericalError&) {  // a step into a region where S is singular
+        lambda *= 10;
+        continue;
+      }
+      if (ev_t.cost <= ev.cost) {
+        accepted = true;
+        break;
+      }
+      lambda *= 10;
+    }
+    if (!accepted) {  // no step lowers V: a minimum to rounding
+      fit.converged = true;
+      break;
+    }
+    double xnorm = 0;
+    for (int c = 0; c < nf; ++c) xnorm += fit.xi[free[c]] * fit.xi[free[c]];
+    const double rel_step = step.norm() / std::max(std::sqrt(xnorm), 1e-300);
+    const double decrease = ev.cost - ev_t.cost;
+    fit.xi = xi_t;
+    fit.theta = theta_t;
+    ev = std::move(ev_t);
+    g = half_gradient(ev, J);
+    fit.iterations = it;
+    fit.cost_history.push_back(ev.cost);
+    lambda = std::max(lambda / 10, 1e-12);
+    // The step is below tol, or V changes only at rounding level with a small step.
+    if (rel_step < tol || (decrease <= 8 * kEps * ev.cost && rel_step < 1e-6)) {
+      fit.converged = true;
+      break;
+    }
+  }
+  fit.cost = ev.cost;
+  fit.information = J.transpose() * J;
+  return fit;
+}
+
+Eigen::MatrixXd ExactLikelihood::residue_covariance(const Eigen::VectorXcd& theta) const {
+  const Factor f = factor(theta);
+  const Eigen::Index n = f.Lb.cols();
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = j; i <= std::min<Eigen::Index>(n - 1, j + kd_); ++i) L(i, j) = f.Lb(i - j, j);
+  return L * L.transpose();
+}
+
+Eigen::MatrixXd eta_covariance(const Parametrisation& p, const Eigen::MatrixXd& cov_free) {
+  const std::vector<int> free = p.free_indices();
+  if (cov_free.rows() != static_cast<Eigen::Index>(free.size()) || cov_free.cols() != cov_free.rows()) {
+    throw std::invalid_argument("cov_free must be square with one row per free parameter");
+  }
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(p.n_eta(), p.n_eta());
+  for (size_t a = 0; a < free.size(); ++a)
+    for (size_t b = 0; b < free.size(); ++b)
+      if (free[a] < p.n_eta() && free[b] < p.n_eta()) out(free[a], free[b]) = cov_free(a, b);
+  return out;
+}
+
+Eigen::MatrixXd cramer_rao_bound(const FrequencyData& noiseless, const Parametrisation& p,
+                                 const std::vector<int>& rows, const Eigen::VectorXcd& theta) {
+  const ExactLikelihood lik(noiseless, p, rows);
+  return eta_covariance(p, symmetric_inverse(lik.fisher_information(theta), "the Fisher information"));
+}
+
+}  // namespace lptv

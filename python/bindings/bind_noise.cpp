@@ -1,0 +1,26 @@
+#include "lptv/noise.hpp"
+#include "pybind11.hpp"
+
+void bind_noise(py::module_& m) {
+  py::class_<lptv::FrequencyData>(m, "FrequencyData",
+                                  "Mean spectra on lines 0..Lmax and the (co)variances of the means.")
+      .def(py::init([](Eigen::VectorXcd U, Eigen::VectorXcd Y, Eigen::VectorXd varU, Eigen::VectorXd varY,
+                       Eigen::VectorXcd covYU, int periods) {
+             lptv::FrequencyData d{std::move(U), std::move(Y), std::move(varU), std::move(varY),
+                                   std::move(covYU), periods};
+             d.validate();
+             return d;
+           }),
+           "U"_a, "Y"_a, "varU"_a, "varY"_a, "covYU"_a, "periods"_a = 0)
+      .def_static("from_periods", [](const Eigen::MatrixXd& u, const Eigen::MatrixXd& y) {
+        py::gil_scoped_release release;  // FFTs only
+        return lptv::frequency_data_from_periods(u, y);
+      }, "u"_a, "y"_a)
+      .def_readonly("U", &lptv::FrequencyData::U)
+      .def_readonly("Y", &lptv::FrequencyData::Y)
+      .def_readonly("varU", &lptv::FrequencyData::varU)
+      .def_readonly("varY", &lptv::FrequencyData::varY)
+      .def_readonly("covYU", &lptv::FrequencyData::covYU)
+      .def_readonly("periods", &lptv::FrequencyData::periods)
+      .def_property_readonly("max_line", &lptv::FrequencyData::max_line);
+}
