@@ -15,12 +15,14 @@ import pytest
 import scipy.io
 
 import lptv
-from lptv import cli, fileid
-from lptv.demo import paper_measurements
+from lptv.apps import cli, fileid
+from lptv.apps.demo import paper_measurements
 
 PAPER_ARGS = ["--na", "2", "--nb", "1", "--ka", "3", "--kb", "3", "--lines", "1-243"]
 PAPER_KW = dict(na=2, nb=1, ka=3, kb=3, lines=range(1, 244))
-LPTV = Path(sys.executable).with_name("lptv")
+# The command as a separate process, from this tree (PYTHONPATH is inherited): the same
+# entry point as the installed ``lptv`` script, which test_console_script_entry_point checks.
+LPTV = [sys.executable, "-m", "lptv"]
 
 
 # ------------------------------------------------------------------------------ writers
@@ -189,10 +191,10 @@ def test_warnings_are_printed_and_kept(small, tmp_path, capsys):
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["warnings"] == list(ref.warnings)
 
 
-def test_installed_command_default_output_folder(small, tmp_path):
+def test_command_default_output_folder(small, tmp_path):
     u, y = small
     np.savez(tmp_path / "bench 1.npz", u=u, y=y)
-    p = subprocess.run([str(LPTV), "identify", "bench 1.npz", "--na", "1", "--nb", "0", "--ts", str(TS)],
+    p = subprocess.run([*LPTV, "identify", "bench 1.npz", "--na", "1", "--nb", "0", "--ts", str(TS)],
                        cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     assert "consistent with the noise" in p.stdout
@@ -342,14 +344,27 @@ def test_unwritable_output_folder(small, tmp_path, capsys):
     assert err == f"lptv identify: error: {taken}: File exists\n"
 
 
-def test_installed_command_exit_status_and_stderr(tmp_path):
+def test_command_exit_status_and_stderr(tmp_path):
     bad = tmp_path / "data.csv"
     bad.write_text("t,u\n0,1\n1,2\n")
-    p = subprocess.run([str(LPTV), "identify", str(bad), "--na", "1", "--nb", "0", "--w0", "1",
+    p = subprocess.run([*LPTV, "identify", str(bad), "--na", "1", "--nb", "0", "--w0", "1",
                         "--periods", "2"], capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and p.stdout == ""
     assert p.stderr == f"lptv identify: error: {bad}: column 'y' is missing (the header has 't', 'u')\n"
-    p = subprocess.run([str(LPTV), "identify", str(bad), "--nb", "0"], capture_output=True, text=True,
+    p = subprocess.run([*LPTV, "identify", str(bad), "--nb", "0"], capture_output=True, text=True,
                        timeout=120)
     assert p.returncode == 2 and "the following arguments are required: --na" in p.stderr
     assert "Traceback" not in p.stderr
+
+
+def test_console_script_entry_point():
+    """The installed ``lptv`` script and ``python -m lptv`` call the same ``main``."""
+    import importlib
+    import re
+
+    pyproject = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text()
+    target = re.search(r'^lptv\s*=\s*"([\w.]+):(\w+)"', pyproject, flags=re.M)
+    assert target, "pyproject.toml declares no lptv script"
+    assert getattr(importlib.import_module(target.group(1)), target.group(2)) is cli.main
+    p = subprocess.run([*LPTV, "--help"], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and p.stdout.startswith("usage: lptv ")

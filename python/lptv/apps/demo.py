@@ -21,13 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plots
-from .examples import PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, noisy_periods, paper_model, paper_multisine
-from .fds import simulate
-from .identify import identify
-from .multisine import time_signal
-from .report import Report, write_json
-from .validation import frozen_poles, frozen_zeros
+from lptv import plots
+from lptv.apps.report import Report, write_json
+from lptv.examples import PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, noisy_periods, paper_model, paper_multisine
+from lptv.fds import simulate
+from lptv.identify import identify
+from lptv.multisine import time_signal
+from lptv.validation import frozen_poles, frozen_zeros
 
 SNR_IN_DB = 50.0
 SNR_OUT_DB = 30.0
@@ -83,7 +83,7 @@ def run(args) -> int:
          f"N = {PAPER_N}, crest factor {data['multisine'].crest_factor:.2f}")
 
     # --- FDS against CVODE (Fig. 2) ---
-    from . import timedomain
+    from lptv import timedomain
 
     Y_fds, t_fds = _time_fds(model, U0)
     ss = timedomain.periodic_steady_state(model, U0, PAPER_N, full_output=True)
@@ -169,7 +169,7 @@ def run(args) -> int:
         "A linear periodically time-varying system (na = 2, nb = 1, 3 harmonics on every "
         "coefficient, 35 parameters of which 34 are free after normalisation) is simulated in the "
         "frequency domain, measured over P noisy periods, and identified from data where both input "
-        "and output are noisy. Every choice is stated in lptv.examples and lptv.demo; every random "
+        "and output are noisy. Every choice is stated in lptv.examples and lptv.apps.demo; every random "
         f"number comes from seed {seed}.")
     rep.table(["quantity", "value"], [[k, v] for k, v in summary.items() if k != "monte_carlo"])
     rep.heading("Simulation: FDS against time integration")

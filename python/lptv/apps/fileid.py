@@ -16,7 +16,7 @@ and exit status 2.
 
 Example (the paper's simulation example as a measurement file, then its identification)::
 
-    python -c "import numpy as np, lptv.demo as d; m = d.paper_measurements(); \\
+    python -c "import numpy as np, lptv.apps.demo as d; m = d.paper_measurements(); \\
                np.savez('meas.npz', u=m['u'], y=m['y'], w0=m['w0'])"
     lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243 --out meas-lptv
 """
@@ -30,13 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plots
-from ._core import NumericalError
-from .fds import simulate
-from .identify import METHODS, identify
-from .measurements import FileError, _one_line, read_measurements
-from .report import Report, write_json
-from .validation import frozen_poles, frozen_zeros
+from lptv import plots
+from lptv._core import NumericalError
+from lptv.apps.report import Report, write_json
+from lptv.fds import simulate
+from lptv.identify import METHODS, identify
+from lptv.measurements import FileError, _one_line, read_measurements
+from lptv.validation import frozen_poles, frozen_zeros
 
 # ------------------------------------------------------------------------------ options
 
