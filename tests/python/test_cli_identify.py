@@ -16,7 +16,7 @@ import scipy.io
 
 import lptv
 from lptv.apps import cli, fileid
-from lptv.apps.demo import paper_measurements
+from lptv.examples import paper_measurements
 
 PAPER_ARGS = ["--na", "2", "--nb", "1", "--ka", "3", "--kb", "3", "--lines", "1-243"]
 PAPER_KW = dict(na=2, nb=1, ka=3, kb=3, lines=range(1, 244))

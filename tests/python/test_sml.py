@@ -94,7 +94,7 @@ def test_sml_covariance_predicts_the_monte_carlo_spread():
 
 
 def test_sml_on_the_paper_example_is_at_least_as_good_as_wgtls():
-    from lptv.apps.demo import paper_measurements
+    from lptv.examples import paper_measurements
 
     d = paper_measurements(seed=3, periods=8)
     kw = dict(na=2, nb=1, ka=3, kb=3, w0=d["w0"], lines=range(1, 244))

@@ -16,7 +16,7 @@ and exit status 2.
 
 Example (the paper's simulation example as a measurement file, then its identification)::
 
-    python -c "import numpy as np, lptv.apps.demo as d; m = d.paper_measurements(); \\
+    python -c "import numpy as np, lptv.examples as ex; m = ex.paper_measurements(); \\
                np.savez('meas.npz', u=m['u'], y=m['y'], w0=m['w0'])"
     lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243 --out meas-lptv
 """
