@@ -22,13 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import plots
+from lptv import frozen_poles, frozen_zeros, identify, plots, simulate
 from lptv.apps.report import Report, write_json
 from lptv.examples import (PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, PAPER_NOISE, PAPER_SNR_IN_DB,
                            PAPER_SNR_OUT_DB, noisy_periods, paper_measurements)
-from lptv.fds import simulate
-from lptv.identify import identify
-from lptv.validation import frozen_poles, frozen_zeros
 
 
 def _say(msg):

@@ -28,13 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import plots
+from lptv import FrequencyData, Model, identify, multisine, plots, simulate, time_signal
 from lptv.apps.report import Report, write_json
 from lptv.examples import noisy_periods
-from lptv.fds import simulate
-from lptv.identify import identify
-from lptv.model import Model
-from lptv.multisine import multisine, time_signal
 
 # --- case 1: the slides' static sensor model
 LS_X = np.linspace(0.0, 1.0, 101)          # the slides' x = 0:0.01:1
@@ -382,8 +378,6 @@ def _figure(ncols=1, figsize=(6.4, 4.0)):
 def _report(out, seed, P, ls, meas, mc, summary, kt):
     from scipy import stats
     from scipy.signal import butter, filtfilt
-
-    from lptv.data import FrequencyData
 
     rep = Report("lptv: the lecture's identification cases")
     rep.paragraph(
