@@ -26,8 +26,8 @@ def _demo_parser(sub):
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="lptv", description=__doc__.split("\n\n")[0] +
-                                     ": identification of linear periodically time-varying systems")
+    parser = argparse.ArgumentParser(
+        prog="lptv", description="lptv: identification of linear periodically time-varying systems")
     sub = parser.add_subparsers(dest="command", required=True)
     _demo_parser(sub)
     from lptv.apps import fileid
