@@ -115,14 +115,14 @@ def test_mat73_writer_looks_like_matlab(tmp_path):
 def test_mat73_is_read_untransposed_and_vectors_split_by_periods(tmp_path):
     u = np.arange(15.0).reshape(3, 5)  # P = 3 periods of N = 5: any transposition shows
     y = -u
-    m = fileid.read_measurements(write_mat73(tmp_path / "a.mat", u=u, y=y))
+    m = lptv.read_measurements(write_mat73(tmp_path / "a.mat", u=u, y=y))
     assert m.format == "MAT v7.3" and m.w0 is None
     np.testing.assert_array_equal(m.u, u)
     np.testing.assert_array_equal(m.y, y)
-    v = fileid.read_measurements(write_mat73(tmp_path / "v.mat", u=u.ravel(), y=y.ravel()), periods=3)
+    v = lptv.read_measurements(write_mat73(tmp_path / "v.mat", u=u.ravel(), y=y.ravel()), periods=3)
     np.testing.assert_array_equal(v.u, u)
     scipy.io.savemat(tmp_path / "c.mat", {"u": u.ravel()[:, None], "y": y.ravel()})  # column, row
-    np.testing.assert_array_equal(fileid.read_measurements(tmp_path / "c.mat", periods=3).u, u)
+    np.testing.assert_array_equal(lptv.read_measurements(tmp_path / "c.mat", periods=3).u, u)
 
 
 def test_parse_lines():
