@@ -1,6 +1,6 @@
 """WGTLS of the C++ core against the NumPy reference, on the paper-like example, side by side.
 
-The data are the demo's measurements (``lptv.demo.paper_measurements(seed, periods=8)``:
+The data are the demo's measurements (``lptv.examples.paper_measurements(seed, periods=8)``:
 8 noisy periods of N = 2048 samples); the model na = 2, nb = 1, 3 harmonics on every
 coefficient (35 free real parameters); rows = lines 1..243; WGTLS to tol = 1e-12. The routes:
 
@@ -37,7 +37,7 @@ import numpy as np
 import lptv
 from lptv import _core
 from lptv.data import FrequencyData
-from lptv.demo import paper_measurements
+from lptv.examples import paper_measurements
 from lptv.reference import identification as ref
 
 NA, NB, K = 2, 1, 3
@@ -78,7 +78,7 @@ def routes(u, y, w0):
 
 def main(n_seeds: int = 3):
     print("WGTLS, C++ core vs NumPy reference (lptv.reference.identification), paper-like example")
-    print(f"data: lptv.demo.paper_measurements(seed, periods=8); na={NA}, nb={NB}, ka=kb={K} "
+    print(f"data: lptv.examples.paper_measurements(seed, periods=8); na={NA}, nb={NB}, ka=kb={K} "
           f"(35 parameters), lines {LINES.start}..{LINES.stop - 1}, tol={TOL:g}")
     print(f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', '(unset: one thread per core)')}"
           " - NumPy's BLAS threads (the core's own BLAS runs single-threaded at this size)")

@@ -13,19 +13,27 @@ amplitudes, w0 or number of periods; the choices below are ours, stated here:
 - w0 = 0.04 rad/s (T0 = 157 s), so the excited lines 10, 20, ..., 240 span 0.4 .. 9.6 rad/s
   around the resonance at 1 rad/s (line 25);
 - the multisine has 24 lines of equal amplitude sqrt(2/24) (rms 1, whatever the number of
-  lines) and N = 2048 samples per period.
+  lines) and N = 2048 samples per period;
+- the measurement noise (``paper_measurements``): 50 dB mean SNR on the input, 30 dB on the
+  output, first-order low-pass noise with poles 0.6 (input) and 0.8 (output), the output noise
+  sharing half of its driving sequence with the input noise (``PAPER_NOISE``).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from .fds import simulate
 from .model import Model
-from .multisine import multisine
+from .multisine import multisine, time_signal
 
 PAPER_W0 = 0.04
 PAPER_N = 2048
 PAPER_EXCITED = np.arange(10, 241, 10)
 PAPER_ID_LINES = np.arange(1, 244)
+PAPER_SNR_IN_DB = 50.0
+PAPER_SNR_OUT_DB = 30.0
+# keyword arguments of noisy_periods: the colour and the correlation of the noise
+PAPER_NOISE = dict(pole_in=0.6, pole_out=0.8, correlation=0.5)
 
 # harmonic k = 1, 2, 3 of each coefficient (harmonic -k is the conjugate); DC values below
 PAPER_DC = {"a0": 1.0, "a1": 1.0, "a2": 1.0, "b0": 1.0, "b1": 1.0}
@@ -102,3 +110,48 @@ def noisy_periods(u0, y0, periods: int, snr_in_db: float, snr_out_db: float, see
     u = np.tile(u0, (P, 1)) + su * cu.reshape(P, N)
     y = np.tile(y0, (P, 1)) + sy * cy.reshape(P, N)
     return u, y
+
+
+def paper_measurements(seed=2024, periods: int = 8) -> dict:
+    """The paper's example as measured: P noisy periods of the input and output, and the truth.
+
+    The model is :func:`paper_model`, the excitation :func:`paper_multisine`, the noise-free
+    output its steady state by :func:`lptv.simulate`, and the noise that of
+    :func:`noisy_periods` at ``PAPER_SNR_IN_DB``, ``PAPER_SNR_OUT_DB`` with ``PAPER_NOISE``.
+    ``lptv demo`` identifies these data.
+
+    Parameters
+    ----------
+    seed : int, sequence of int or numpy.random.Generator
+        Seeds the multisine's phases and then the noise.
+    periods : int
+        Number of measured periods P.
+
+    Returns
+    -------
+    dict
+        ``u``, ``y`` (P, N) the measured periods; ``w0`` (rad/s); ``u0``, ``y0`` one noise-free
+        period; ``U0``, ``Y0`` their one-sided spectra; ``model`` the true :class:`lptv.Model`;
+        ``multisine`` the excitation (:class:`lptv.Multisine`).
+
+    Examples
+    --------
+    >>> import lptv
+    >>> from lptv.examples import paper_measurements
+    >>> m = paper_measurements(seed=1, periods=4)
+    >>> m["u"].shape, m["w0"]
+    ((4, 2048), 0.04)
+    >>> res = lptv.identify(m["u"], m["y"], na=2, nb=1, ka=3, kb=3, w0=m["w0"],
+    ...                     lines=range(1, 244))
+    >>> res.n_free_parameters
+    34
+    """
+    rng = np.random.default_rng(seed)
+    model = paper_model()
+    ms = paper_multisine(seed=rng)
+    Y0 = simulate(model, ms.spectrum)
+    y0 = time_signal(Y0, PAPER_N)
+    u, y = noisy_periods(ms.signal, y0, periods, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB, seed=rng,
+                         **PAPER_NOISE)
+    return dict(u=u, y=y, w0=model.w0, u0=ms.signal, y0=y0, U0=ms.spectrum, Y0=Y0, model=model,
+                multisine=ms)

@@ -15,12 +15,14 @@ import pytest
 import scipy.io
 
 import lptv
-from lptv import cli, fileid
-from lptv.demo import paper_measurements
+from lptv.apps import cli, fileid
+from lptv.examples import paper_measurements
 
 PAPER_ARGS = ["--na", "2", "--nb", "1", "--ka", "3", "--kb", "3", "--lines", "1-243"]
 PAPER_KW = dict(na=2, nb=1, ka=3, kb=3, lines=range(1, 244))
-LPTV = Path(sys.executable).with_name("lptv")
+# The command as a separate process, from this tree (PYTHONPATH is inherited): the same
+# entry point as the installed ``lptv`` script, which test_console_script_entry_point checks.
+LPTV = [sys.executable, "-m", "lptv"]
 
 
 # ------------------------------------------------------------------------------ writers
@@ -113,14 +115,14 @@ def test_mat73_writer_looks_like_matlab(tmp_path):
 def test_mat73_is_read_untransposed_and_vectors_split_by_periods(tmp_path):
     u = np.arange(15.0).reshape(3, 5)  # P = 3 periods of N = 5: any transposition shows
     y = -u
-    m = fileid.read_measurements(write_mat73(tmp_path / "a.mat", u=u, y=y))
+    m = lptv.read_measurements(write_mat73(tmp_path / "a.mat", u=u, y=y))
     assert m.format == "MAT v7.3" and m.w0 is None
     np.testing.assert_array_equal(m.u, u)
     np.testing.assert_array_equal(m.y, y)
-    v = fileid.read_measurements(write_mat73(tmp_path / "v.mat", u=u.ravel(), y=y.ravel()), periods=3)
+    v = lptv.read_measurements(write_mat73(tmp_path / "v.mat", u=u.ravel(), y=y.ravel()), periods=3)
     np.testing.assert_array_equal(v.u, u)
     scipy.io.savemat(tmp_path / "c.mat", {"u": u.ravel()[:, None], "y": y.ravel()})  # column, row
-    np.testing.assert_array_equal(fileid.read_measurements(tmp_path / "c.mat", periods=3).u, u)
+    np.testing.assert_array_equal(lptv.read_measurements(tmp_path / "c.mat", periods=3).u, u)
 
 
 def test_parse_lines():
@@ -189,10 +191,10 @@ def test_warnings_are_printed_and_kept(small, tmp_path, capsys):
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["warnings"] == list(ref.warnings)
 
 
-def test_installed_command_default_output_folder(small, tmp_path):
+def test_command_default_output_folder(small, tmp_path):
     u, y = small
     np.savez(tmp_path / "bench 1.npz", u=u, y=y)
-    p = subprocess.run([str(LPTV), "identify", "bench 1.npz", "--na", "1", "--nb", "0", "--ts", str(TS)],
+    p = subprocess.run([*LPTV, "identify", "bench 1.npz", "--na", "1", "--nb", "0", "--ts", str(TS)],
                        cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     assert "consistent with the noise" in p.stdout
@@ -342,14 +344,27 @@ def test_unwritable_output_folder(small, tmp_path, capsys):
     assert err == f"lptv identify: error: {taken}: File exists\n"
 
 
-def test_installed_command_exit_status_and_stderr(tmp_path):
+def test_command_exit_status_and_stderr(tmp_path):
     bad = tmp_path / "data.csv"
     bad.write_text("t,u\n0,1\n1,2\n")
-    p = subprocess.run([str(LPTV), "identify", str(bad), "--na", "1", "--nb", "0", "--w0", "1",
+    p = subprocess.run([*LPTV, "identify", str(bad), "--na", "1", "--nb", "0", "--w0", "1",
                         "--periods", "2"], capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and p.stdout == ""
     assert p.stderr == f"lptv identify: error: {bad}: column 'y' is missing (the header has 't', 'u')\n"
-    p = subprocess.run([str(LPTV), "identify", str(bad), "--nb", "0"], capture_output=True, text=True,
+    p = subprocess.run([*LPTV, "identify", str(bad), "--nb", "0"], capture_output=True, text=True,
                        timeout=120)
     assert p.returncode == 2 and "the following arguments are required: --na" in p.stderr
     assert "Traceback" not in p.stderr
+
+
+def test_console_script_entry_point():
+    """The installed ``lptv`` script and ``python -m lptv`` call the same ``main``."""
+    import importlib
+    import re
+
+    pyproject = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text()
+    target = re.search(r'^lptv\s*=\s*"([\w.]+):(\w+)"', pyproject, flags=re.M)
+    assert target, "pyproject.toml declares no lptv script"
+    assert getattr(importlib.import_module(target.group(1)), target.group(2)) is cli.main
+    p = subprocess.run([*LPTV, "--help"], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and p.stdout.startswith("usage: lptv ")

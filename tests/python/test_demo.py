@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from lptv import cli
+from lptv.apps import cli
 
 FILES = ["report.html", "summary.json", "fig2_fds_vs_cvode.png", "fig3_frozen_poles_zeros.png",
          "fig4_prediction_error.png", "fig5_frozen_poles_zoom.png", "fig6_normalized_residue.png",

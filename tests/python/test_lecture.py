@@ -1,4 +1,4 @@
-"""``lptv demo lecture``: the lecture's cases (lptv.lecture) judged against the truth.
+"""``lptv demo lecture``: the lecture's cases (lptv.apps.lecture) judged against the truth.
 
 The demo runs once in quick mode (the same code path as the full run, fewer Monte Carlo
 realisations); the tests read what it wrote. Every tolerance is justified where it is used.
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from lptv import lecture
+from lptv.apps import lecture
 
 SEED = 2024
 FIGURES = ("fig1_static_ls.png", "fig2_smd_measurement.png", "fig3_monte_carlo.png",

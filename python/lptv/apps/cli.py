@@ -26,11 +26,11 @@ def _demo_parser(sub):
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="lptv", description=__doc__.split("\n\n")[0] +
-                                     ": identification of linear periodically time-varying systems")
+    parser = argparse.ArgumentParser(
+        prog="lptv", description="lptv: identification of linear periodically time-varying systems")
     sub = parser.add_subparsers(dest="command", required=True)
     _demo_parser(sub)
-    from . import fileid
+    from lptv.apps import fileid
 
     fileid.add_parser(sub)
     args = parser.parse_args(argv)
@@ -40,10 +40,10 @@ def main(argv=None) -> int:
         if args.periods < 2:
             parser.error("--periods must be >= 2")
         if args.case == "lecture":
-            from . import lecture
+            from lptv.apps import lecture
 
             return lecture.run(args)
-        from . import demo
+        from lptv.apps import demo
 
         return demo.run(args)
     if args.command == "identify":

@@ -17,7 +17,7 @@ class Report:
     Examples
     --------
     >>> import tempfile, lptv
-    >>> from lptv.report import Report
+    >>> from lptv.apps.report import Report
     >>> r = Report("Example")
     >>> r.paragraph("One table.")
     >>> r.table(["a", "b"], [[1, 2.5]])

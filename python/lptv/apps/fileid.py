@@ -16,7 +16,7 @@ and exit status 2.
 
 Example (the paper's simulation example as a measurement file, then its identification)::
 
-    python -c "import numpy as np, lptv.demo as d; m = d.paper_measurements(); \\
+    python -c "import numpy as np, lptv.examples as ex; m = ex.paper_measurements(); \\
                np.savez('meas.npz', u=m['u'], y=m['y'], w0=m['w0'])"
     lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243 --out meas-lptv
 """
@@ -30,13 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plots
-from ._core import NumericalError
-from .fds import simulate
-from .identify import METHODS, identify
-from .measurements import FileError, _one_line, read_measurements
-from .report import Report, write_json
-from .validation import frozen_poles, frozen_zeros
+from lptv import (NumericalError, frozen_poles, frozen_zeros, identify, plots, read_measurements,
+                  simulate)
+from lptv.apps.report import Report, write_json
+from lptv.identify import METHODS  # the estimator names; the package exports no list of them
+from lptv.measurements import FileError
 
 # ------------------------------------------------------------------------------ options
 
@@ -148,6 +146,11 @@ def add_parser(sub):
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
     p.add_argument("--tol", type=float, default=1e-10, help="WGTLS relative tolerance (default 1e-10)")
     return p
+
+
+def _one_line(problem) -> str:
+    """A message on one line (the command's errors are one line), or the exception's type."""
+    return " ".join(str(problem).split()) or type(problem).__name__
 
 
 def _fail(name, problem) -> int:

@@ -7,7 +7,8 @@ Every choice is stated in :mod:`lptv.examples` and below; every random number is
    both timed in the same run.
 3. P periods of input and output with colored, correlated noise at 50 dB (input) and 30 dB
    (output) mean SNR: first-order low-pass noise with poles 0.6 (input) and 0.8 (output), the
-   output noise sharing half of its driving sequence with the input noise (correlation 0.5).
+   output noise sharing half of its driving sequence with the input noise (correlation 0.5);
+   these are :func:`lptv.examples.paper_measurements`.
 4. TLS and WGTLS on lines 1..243 (34 free parameters).
 5. Validation: frozen poles and zeros (Figs. 3, 5), predicted output against the noise level
    (Fig. 4), normalised residues (Fig. 6).
@@ -21,38 +22,14 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plots
-from .examples import PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, noisy_periods, paper_model, paper_multisine
-from .fds import simulate
-from .identify import identify
-from .multisine import time_signal
-from .report import Report, write_json
-from .validation import frozen_poles, frozen_zeros
-
-SNR_IN_DB = 50.0
-SNR_OUT_DB = 30.0
-NOISE = dict(pole_in=0.6, pole_out=0.8, correlation=0.5)
+from lptv import frozen_poles, frozen_zeros, identify, plots, simulate
+from lptv.apps.report import Report, write_json
+from lptv.examples import (PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, PAPER_NOISE, PAPER_SNR_IN_DB,
+                           PAPER_SNR_OUT_DB, noisy_periods, paper_measurements)
 
 
 def _say(msg):
     print(msg, flush=True)
-
-
-def paper_measurements(seed: int = 2024, periods: int = 8):
-    """The demo's measured data: (u, y, w0) with u, y of shape (P, N), and the noise-free truth.
-
-    Returns
-    -------
-    dict with u, y (P, N), w0, u0, y0 (one noise-free period), U0, Y0 (their spectra), model
-    """
-    rng = np.random.default_rng(seed)
-    model = paper_model()
-    ms = paper_multisine(seed=rng)
-    Y0 = simulate(model, ms.spectrum)
-    y0 = time_signal(Y0, PAPER_N)
-    u, y = noisy_periods(ms.signal, y0, periods, SNR_IN_DB, SNR_OUT_DB, seed=rng, **NOISE)
-    return dict(u=u, y=y, w0=model.w0, u0=ms.signal, y0=y0, U0=ms.spectrum, Y0=Y0, model=model,
-                multisine=ms)
 
 
 def _param_error(model, truth):
@@ -83,7 +60,7 @@ def run(args) -> int:
          f"N = {PAPER_N}, crest factor {data['multisine'].crest_factor:.2f}")
 
     # --- FDS against CVODE (Fig. 2) ---
-    from . import timedomain
+    from lptv import timedomain
 
     Y_fds, t_fds = _time_fds(model, U0)
     ss = timedomain.periodic_steady_state(model, U0, PAPER_N, full_output=True)
@@ -134,8 +111,8 @@ def run(args) -> int:
         "seed": seed,
         "n_free_parameters": wg.n_free_parameters,
         "n_lines": int(lines.size),
-        "snr_in_db": SNR_IN_DB,
-        "snr_out_db": SNR_OUT_DB,
+        "snr_in_db": PAPER_SNR_IN_DB,
+        "snr_out_db": PAPER_SNR_OUT_DB,
         "periods": P,
         "fds_vs_cvode_db": fds_vs_cvode_db,
         "fds_seconds": t_fds,
@@ -169,7 +146,7 @@ def run(args) -> int:
         "A linear periodically time-varying system (na = 2, nb = 1, 3 harmonics on every "
         "coefficient, 35 parameters of which 34 are free after normalisation) is simulated in the "
         "frequency domain, measured over P noisy periods, and identified from data where both input "
-        "and output are noisy. Every choice is stated in lptv.examples and lptv.demo; every random "
+        "and output are noisy. Every choice is stated in lptv.examples and lptv.apps.demo; every random "
         f"number comes from seed {seed}.")
     rep.table(["quantity", "value"], [[k, v] for k, v in summary.items() if k != "monte_carlo"])
     rep.heading("Simulation: FDS against time integration")
@@ -251,7 +228,8 @@ def _monte_carlo(model, data, runs, seed, P, kw):
     errs = {"tls": [], "wgtls": []}
     t0 = time.perf_counter()
     for r in range(runs):
-        u, y = noisy_periods(data["u0"], data["y0"], P, SNR_IN_DB, SNR_OUT_DB, seed=rng, **NOISE)
+        u, y = noisy_periods(data["u0"], data["y0"], P, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB, seed=rng,
+                             **PAPER_NOISE)
         for m in errs:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")

@@ -28,13 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plots
-from .examples import noisy_periods
-from .fds import simulate
-from .identify import identify
-from .model import Model
-from .multisine import multisine, time_signal
-from .report import Report, write_json
+from lptv import FrequencyData, Model, identify, multisine, plots, simulate, time_signal
+from lptv.apps.report import Report, write_json
+from lptv.examples import noisy_periods
 
 # --- case 1: the slides' static sensor model
 LS_X = np.linspace(0.0, 1.0, 101)          # the slides' x = 0:0.01:1
@@ -383,14 +379,12 @@ def _report(out, seed, P, ls, meas, mc, summary, kt):
     from scipy import stats
     from scipy.signal import butter, filtfilt
 
-    from .data import FrequencyData
-
     rep = Report("lptv: the lecture's identification cases")
     rep.paragraph(
         "Three cases from the lecture on system identification and filtering: static least squares, "
         "the grey-box spring-mass-damper identified the lecture's way (filtered time-domain least "
         "squares) and from the same records in the frequency domain, and the same system with a "
-        f"periodically varying stiffness. Every choice is stated in lptv.lecture; every random number "
+        f"periodically varying stiffness. Every choice is stated in lptv.apps.lecture; every random number "
         f"comes from seed {seed}.")
 
     rep.heading("1. Static least squares: y = 10 x + 50")
