@@ -5,7 +5,9 @@ The public API:
 - :class:`Model` - the LPTV model (and LTI as its special case), JSON save/load;
 - :func:`multisine`, :func:`spectrum`, :func:`time_signal` - excitation and spectra;
 - :func:`simulate`, :func:`htf`, :func:`band_matrices` - the frequency-domain simulator;
-- :class:`FrequencyData`, :func:`identify` - noise model and estimators (LS, TLS, GTLS, WGTLS);
+- :class:`FrequencyData`, :func:`identify` - noise model and estimators (LS, TLS, GTLS, WGTLS,
+  SML on the exact likelihood) with the covariance of the estimate;
+- :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
 - :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
@@ -13,7 +15,8 @@ The public API:
 from ._core import NumericalError
 from .fds import SimulationResult, TruncationWarning, band_matrices, htf, simulate
 from .data import FrequencyData
-from .identify import IdentifiabilityWarning, IdentificationResult, identify
+from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
+from .uncertainty import CramerRaoBound, crb
 from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
@@ -22,7 +25,7 @@ from .multisine import Multisine, multisine, spectrum, time_signal
 __version__ = "0.1.0"
 
 __all__ = [
-    "FrequencyData", "IdentifiabilityWarning", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
-    "band_matrices", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
+    "CramerRaoBound", "FrequencyData", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
+    "band_matrices", "crb", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
     "identify", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
 ]

@@ -46,7 +46,7 @@ def expected_fraction_above_0db(n_rows: int, n_free: int, periods: int):
     >>> import lptv
     >>> p, (lo, hi) = lptv.expected_fraction_above_0db(243, 34, 8)
     >>> round(p, 3), round(lo, 3), round(hi, 3)
-    (0.425, 0.33, 0.52)
+    (0.368, 0.275, 0.461)
     """
     n_rows = as_int(n_rows, "n_rows", minimum=1)
     n_free = as_int(n_free, "n_free")

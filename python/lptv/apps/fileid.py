@@ -33,7 +33,7 @@ import numpy as np
 from lptv import (NumericalError, frozen_poles, frozen_zeros, identify, plots, read_measurements,
                   simulate)
 from lptv.apps.report import Report, write_json
-from lptv.identify import METHODS  # the estimator names; the package exports no list of them
+from lptv import METHODS
 from lptv.measurements import FileError
 
 # ------------------------------------------------------------------------------ options

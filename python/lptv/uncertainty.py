@@ -1,0 +1,120 @@
+"""The Cramer-Rao bound of a design (METHOD.md section 10), to plan an experiment."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _core
+from ._validate import as_int, as_spectrum
+from .fds import simulate
+from .identify import _counts, _known_list, _rows
+from .model import Model
+from .multisine import Multisine
+
+
+@dataclass(frozen=True)
+class CramerRaoBound:
+    """What :func:`crb` returns."""
+
+    covariance: np.ndarray
+    """The bound on the covariance of ``eta`` (zero row and column for the normalised parameter)."""
+    eta: np.ndarray
+    """The true free real parameters (normalised as :func:`identify` normalises)."""
+    eta_names: Tuple[str, ...]
+    lines: np.ndarray
+    periods: int
+
+    @property
+    def std(self) -> np.ndarray:
+        """The smallest standard deviation an unbiased estimator can reach, per entry of ``eta``."""
+        return np.sqrt(np.diag(self.covariance))
+
+    def relative_std(self) -> np.ndarray:
+        """``std / |eta|`` (inf where the parameter is zero)."""
+        with np.errstate(divide="ignore"):
+            return np.where(self.eta != 0, self.std / np.abs(self.eta), np.inf)
+
+
+def _per_line(v, n, name):
+    arr = np.asarray(v, dtype=complex if name == "cov_yu" else float)
+    if arr.ndim == 0:
+        arr = np.full(n, arr)
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or one value per line 0..{n - 1} ({n} values), "
+                         f"got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} contains NaN or inf")
+    if name != "cov_yu" and np.any(arr < 0):
+        raise ValueError(f"{name} must be >= 0")
+    return arr
+
+
+def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, lines=None,
+        ka: Union[None, int, Sequence[int]] = None, kb: Union[None, int, Sequence[int]] = None,
+        known: Optional[Mapping] = None) -> CramerRaoBound:
+    """Cramer-Rao bound of the parameters for a design: true model, excitation, noise levels.
+
+    The smallest covariance an unbiased estimator of ``eta`` can have when ``periods`` steady-state
+    periods of the excitation are measured with noise of the given spectral (co)variances on input
+    and output (METHOD.md section 10: F = J0^T S0^-1 J0 with the noiseless spectra). ``method='sml'``
+    reaches it for many lines and known noise; with noise variances estimated from P periods its
+    variance is about (P-2)/(P-3) times the bound.
+
+    Parameters
+    ----------
+    model : lptv.Model
+        The true system.
+    u : Multisine or array_like
+        The excitation: a :class:`Multisine` or its one-sided spectrum on lines 0..L
+        (``fft(u)[l] / N``).
+    var_y, var_u : float or array_like over lines 0..L
+        Variance of the noise on ONE period's spectrum, per line: white noise of standard
+        deviation ``s`` in time with N samples per period gives ``s**2 / N``.
+    cov_yu : complex or array_like
+        E{dY conj(dU)} of one period's spectra (correlated input and output noise).
+    periods : int
+        P: the measured periods; the spectra's means then have the (co)variances above / P.
+    lines : sequence of int, optional
+        The rows of the fit (default as :func:`identify`).
+    ka, kb, known :
+        The structure to estimate (default: the model's own orders and harmonic counts).
+
+    Examples
+    --------
+    >>> import lptv
+    >>> m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)          # 1 / (s + 2)
+    >>> ms = lptv.multisine(range(1, 60), 256, seed=0)
+    >>> b = lptv.crb(m, ms, var_u=1e-6 / 256, var_y=1e-6 / 256, periods=8)
+    >>> b.eta_names
+    ('a0.re0', 'a1.re0', 'b0.re0')
+    >>> bool(b.std[0] < 1e-2)
+    True
+    """
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+    U = u.spectrum if isinstance(u, Multisine) else as_spectrum(u, "u")
+    if U.ndim != 1:
+        raise ValueError(f"u must be one spectrum (1-D), got shape {U.shape}")
+    periods = as_int(periods, "periods", minimum=1)
+    n = U.size
+    vy, vu = _per_line(var_y, n, "var_y"), _per_line(var_u, n, "var_u")
+    cyu = _per_line(cov_yu, n, "cov_yu")
+    if np.any(np.abs(cyu) ** 2 > vy * vu * (1 + 1e-12)):
+        raise ValueError("cov_yu: |cov_yu|^2 must not exceed var_y * var_u on any line")
+    Y = simulate(model, U)
+    data = _core.FrequencyData(U, Y, vu / periods, vy / periods, cyu / periods, 0)
+    na, nb = model.na, model.nb
+    ka_l = _counts(model.ka if ka is None else ka, na, "ka")
+    kb_l = _counts(model.kb if kb is None else kb, nb, "kb")
+    kn = _known_list(known, ka_l, kb_l)
+    par = _core.Parametrisation(na, nb, ka_l, kb_l, kn, model.w0, 0.0 if model.ts is None else model.ts)
+    rows = par.default_rows(data.max_line) if lines is None else _rows(lines)
+    par.check_rows(rows, data.max_line)
+    xi = np.asarray(par.xi_from_theta(np.asarray(par.theta_from_model(model._cpp))))
+    theta = np.asarray(par.theta_from_xi(xi))   # normalised, as the estimates are
+    xi = xi / xi[par.norm_index]
+    cov = np.asarray(_core.cramer_rao_bound(data, par, rows, theta))
+    return CramerRaoBound(covariance=cov, eta=xi[:par.n_eta], eta_names=tuple(par.eta_names),
+                          lines=np.asarray(rows), periods=periods)
