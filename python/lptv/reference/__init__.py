@@ -5,9 +5,12 @@ It reads a model's coefficient arrays and never calls the core's computations.
 
 - :mod:`lptv.reference.fds` (re-exported here): model, band matrices, FDS, multisines;
 - :mod:`lptv.reference.identification`: noise model, Jacobian, residue variance, column
-  covariance, LS / TLS / GTLS / WGTLS.
+  covariance, LS / TLS / GTLS / WGTLS;
+- :mod:`lptv.reference.likelihood`: the exact likelihood of LPTV rows (real noise vector,
+  residue covariance S, cost r^T S^-1 r and its gradient), its minimiser and the Cramer-Rao
+  bound, all dense.
 """
-from . import identification
+from . import identification, likelihood
 from .fds import (
     band_matrix_A,
     band_matrix_B,
@@ -25,7 +28,7 @@ from .fds import (
 )
 
 __all__ = [
-    "identification", "band_matrix_A", "band_matrix_B", "coefficients_at", "crest_factor", "full_spectrum", "grid",
-    "htf", "line_variable", "multisine_spectrum", "samples_per_period", "simulate", "spectrum",
-    "time_signal",
+    "identification", "likelihood", "band_matrix_A", "band_matrix_B", "coefficients_at",
+    "crest_factor", "full_spectrum", "grid", "htf", "line_variable", "multisine_spectrum",
+    "samples_per_period", "simulate", "spectrum", "time_signal",
 ]
