@@ -105,3 +105,28 @@ def test_sml_on_the_paper_example_is_at_least_as_good_as_wgtls():
     lik = _core.ExactLikelihood(sm.data._cpp, par, [int(r) for r in sm.lines])
     assert lik.cost(sm.theta) < lik.cost(wg.theta)
     assert sm.residue_ok
+
+
+@pytest.mark.parametrize("method", ["wgtls", "sml"])
+def test_coverage_of_95_percent_intervals(method):
+    """The calibrated covariance: 95 % intervals of every free parameter, pooled over 150 seeded
+    realisations (P = 6), must cover at least 85 % of the true values. bench/RESULTS.md measures
+    the coverage precisely (93-98 %) on the paper's example; 85 % is far below the sampling
+    spread of this small study (pooled binomial std ~1 %) and catches an uncorrected or
+    mis-scaled covariance (the diagonal SML's covered 75-88 %)."""
+    m, ms, y0 = small_data(6, 0)
+    par = _core.Parametrisation(1, 0, [1, 1], [1], [], m.w0, 0.0)
+    truth = np.asarray(par.xi_from_theta(par.theta_from_model(m._cpp)))
+    truth = truth / truth[par.norm_index]
+    rng = np.random.default_rng(20261123)
+    hits = []
+    for _ in range(150):
+        u, y = noisy_periods(ms.signal, y0, 6, 20, 20, seed=rng, correlation=0.3)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = lptv.identify(u, y, method=method, **KW)
+        lo, hi = res.confidence_interval(0.95).T
+        free = res.parameter_std > 0
+        hits.append((lo[free] <= truth[free]) & (truth[free] <= hi[free]))
+    coverage = np.mean(hits)
+    assert coverage >= 0.85, coverage
