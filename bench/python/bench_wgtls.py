@@ -61,7 +61,7 @@ def routes(u, y, w0):
 
     def core():
         r = _core.estimate(core_data._cpp, core_par, rows, method="wgtls", tol=TOL, max_iter=50)
-        return np.asarray(r["theta"]), r["iterations"]
+        return np.asarray(r.theta), r.iterations
 
     def reference():
         data = ref.frequency_data(u, y)

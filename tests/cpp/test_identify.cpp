@@ -132,3 +132,23 @@ TEST_CASE("noise statistics of periods", "[noise]") {
   (void)U1;
   REQUIRE_THROWS_AS(lptv::frequency_data_from_periods(u.topRows(1), y.topRows(1)), std::invalid_argument);
 }
+
+TEST_CASE("GTLS: the Cholesky-whitened SVD agrees with the GSVD on a positive definite pair", "[gsvd]") {
+  std::mt19937 gen(17);
+  std::normal_distribution<double> nd;
+  const int n = 9;
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n), G(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      if (j >= i) R(i, j) = nd(gen) * std::pow(10.0, j % 3);  // uneven column scales
+      G(i, j) = nd(gen);
+    }
+  const Eigen::MatrixXd CJ = G.transpose() * G + 1e-2 * Eigen::MatrixXd::Identity(n, n);
+  const lptv::GtlsSolve fast = lptv::gtls_from_r(R, CJ);  // CJ positive definite: Cholesky route
+  const Eigen::MatrixXd B = Eigen::LLT<Eigen::MatrixXd>(CJ).matrixU();  // B^T B = CJ
+  const lptv::GeneralizedPairs g = lptv::gsvd_pairs(R, B);
+  REQUIRE(fast.values.size() == g.values.size());
+  for (int i = 0; i < n; ++i) REQUIRE(fast.values[i] == Approx(g.values[i]).epsilon(1e-10));
+  const Eigen::VectorXd a = fast.x / fast.x.norm(), b = g.vectors.col(0) / g.vectors.col(0).norm();
+  REQUIRE(std::min((a - b).norm(), (a + b).norm()) < 1e-9);
+}
