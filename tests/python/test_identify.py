@@ -292,3 +292,26 @@ def test_error_ts_does_not_fit_the_period(small_periods):
     u, y = small_periods
     with pytest.raises(ValueError, match="64 samples per period, but w0 = 0.1 and ts = 0.2"):
         lptv.identify(u, y, na=1, nb=0, w0=0.1, ts=0.2)
+
+
+def test_identifiability_warning_blames_over_parametrisation_only():
+    """One harmonic too many (a common periodic factor) is named; an under-ordered model, whose
+    residues are too large, is left to the residue test; the correct model draws no warning
+    (bench/python/bench_identifiability.py measures the rates over 200 fits per case)."""
+    from lptv.examples import paper_measurements
+
+    d = paper_measurements(seed=5, periods=8)
+    data = lptv.FrequencyData.from_periods(d["u"], d["y"], w0=d["w0"])
+
+    def fit(**kw):
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            res = lptv.identify(data, nb=1, method="wgtls", **kw)
+        return res, any(issubclass(x.category, lptv.IdentifiabilityWarning) for x in w)
+
+    res, warned = fit(na=2, ka=3, kb=3, lines=range(1, 244))
+    assert res.residue_ok and not warned and not res.nearly_unidentifiable
+    res, warned = fit(na=2, ka=4, kb=4, lines=range(1, 243))
+    assert warned and res.nearly_unidentifiable
+    res, warned = fit(na=1, ka=3, kb=3, lines=range(1, 244))
+    assert not res.residue_ok and not warned
