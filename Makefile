@@ -3,6 +3,7 @@
 #   make test   - install, build, run the C++ tests (ctest), the CMake consumer and pytest
 #   make demo   - install and run the main job (lptv demo)
 #   make bench  - install (with SUNDIALS), build and run the benchmarks
+#   make stubs  - regenerate python/lptv/_core.pyi after a change of the bindings
 SHELL := /bin/bash
 .DEFAULT_GOAL := test
 VENV ?= .venv
@@ -20,11 +21,11 @@ APT_BENCH := libsundials-dev
 # dependencies are in pyproject.toml).
 PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
 	numpy==2.4.6 scipy==1.17.1 pytest==9.2.0 hypothesis==6.170.15 matplotlib==3.11.2 \
-	scikit-sundae==1.2.0 h5py==3.16.0
+	scikit-sundae==1.2.0 h5py==3.16.0 pybind11-stubgen==3.0.0
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: test demo bench deps deps-bench venv cpp cpp-test consumer python pytest clean
+.PHONY: test demo bench deps deps-bench venv cpp cpp-test consumer python pytest stubs clean
 
 # Installs the Debian packages that are missing (apt-get update only when needed).
 define apt_install
@@ -77,6 +78,13 @@ pytest: python
 	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
 
 test: cpp-test consumer pytest
+
+# Regenerates python/lptv/_core.pyi (the compiled module's type stubs, shipped in the wheel)
+# from the installed module; tests/python/test_stubs.py fails when they are out of date.
+stubs: python
+	rm -rf $(BUILDROOT)/stubs
+	$(VENV)/bin/pybind11-stubgen lptv._core -o $(BUILDROOT)/stubs >/dev/null
+	cp $(BUILDROOT)/stubs/lptv/_core.pyi python/lptv/_core.pyi
 
 demo: python
 	$(VENV)/bin/lptv demo
