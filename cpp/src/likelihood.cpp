@@ -224,7 +224,10 @@ Eigen::MatrixXd ExactLikelihood::real_jacobian(const FrequencyData& x) const {
 }
 
 ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Eigen::VectorXcd& theta) const {
-  const Factor f = factor(theta);
+  return evaluate(factor(theta), true);
+}
+
+ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Factor& f, bool whiten) const {
   Evaluation ev;
   ev.whitened = f.r;
   forward_solve(f.Lb, kd_, ev.whitened);
@@ -248,6 +251,7 @@ ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Eigen::VectorXcd& th
     ev.denoised.U[m] -= cd(z[m][2], z[m][3]);
   }
   ev.jacobian = real_jacobian(ev.denoised);
+  if (!whiten) return ev;  // the Jacobian at x0, not whitened; no gradient
   forward_solve(f.Lb, kd_, ev.jacobian);
   ev.gradient = 2.0 * ev.jacobian.transpose() * ev.whitened;
   return ev;
@@ -283,9 +287,8 @@ Eigen::MatrixXd ExactLikelihood::sandwich_covariance(const Eigen::VectorXcd& the
                                                      const Eigen::VectorXd& weights) const {
   const int R = static_cast<int>(sorted_.size());
   if (weights.size() != R) throw std::invalid_argument("weights must have one entry per row");
-  const Evaluation ev = evaluate(theta);
-  Factor f = factor(theta);
-  Eigen::MatrixXd J = free_columns(real_jacobian(ev.denoised), p_.free_indices());
+  const Factor f = factor(theta);
+  Eigen::MatrixXd J = free_columns(evaluate(f, false).jacobian, p_.free_indices());
   for (int r = 0; r < R; ++r) J.middleRows(2 * r, 2) *= weights[order_[r]];  // W J
   // J^T W S W J = (L^T W J)^T (L^T W J): L^T applied to each column from the band.
   const Eigen::Index n = 2 * R;

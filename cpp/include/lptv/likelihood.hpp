@@ -59,6 +59,8 @@ class ExactLikelihood {
  private:
   struct Factor;  // the banded Cholesky factor of S and the per-entry blocks
   Factor factor(const Eigen::VectorXcd& theta) const;
+  // With whiten = false: cost, w and x0, and the Jacobian at x0 not whitened (no gradient).
+  Evaluation evaluate(const Factor& f, bool whiten) const;
   Eigen::MatrixXd real_jacobian(const FrequencyData& x) const;  // dr/dxi, sorted-row order
 
   FrequencyData d_;
