@@ -95,7 +95,7 @@ bench: deps-bench python
 	$(CMAKE) --build $(BUILDROOT)/bench -j $(JOBS)
 	$(MAKE) --no-print-directory -C . bench-run
 
-# Runs the built benchmarks (3 to 4 minutes on 2 cores); every output is also kept in
+# Runs the built benchmarks (5 to 6 minutes on 2 cores); every output is also kept in
 # $(BENCH_OUT) for bench/RESULTS.md. Smaller runs: make bench BENCH_MAX_LINES=1000000.
 BENCH_BIN := $(BUILDROOT)/bench/bench/cpp
 BENCH_OUT := $(BUILDROOT)/bench/results
@@ -112,6 +112,9 @@ bench-run:
 	set -o pipefail; ./$(BENCH_BIN)/bench_wgtls | tee $(BENCH_OUT)/wgtls.txt
 	set -o pipefail; $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py.txt
 	set -o pipefail; OPENBLAS_NUM_THREADS=1 $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py_1thread.txt
+	set -o pipefail; $(PY) bench/python/bench_sml.py | tee $(BENCH_OUT)/sml.txt
+	set -o pipefail; $(PY) bench/python/bench_uncertainty.py 400 | tee $(BENCH_OUT)/uncertainty.txt
+	set -o pipefail; $(PY) bench/python/bench_identifiability.py 200 | tee $(BENCH_OUT)/identifiability.txt
 	@echo "load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg)" | tee -a $(BENCH_OUT)/machine.txt
 
 clean:
