@@ -21,4 +21,5 @@ PYBIND11_MODULE(_core, m) {
   bind_jacobian(m);
   bind_likelihood(m);
   bind_estimators(m);
+  bind_htf_estimate(m);
 }

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'FrequencyData', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'expected_fraction_above_0db', 'gsvd_pairs', 'htf', 'identify', 'jacobian', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'jacobian', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -291,6 +291,25 @@ class Identification:
     @property
     def warnings(self) -> list[str]:
         ...
+class HtfEstimate:
+    """
+    Nonparametric HTF branches (lptv::htf_estimate).
+    """
+    @property
+    def G(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
+    @property
+    def branch_statistic(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def branches(self) -> int:
+        ...
+    @property
+    def lines(self) -> list[int]:
+        ...
+    @property
+    def variance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
 def band_matrix(model: Model, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
 def column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -307,11 +326,15 @@ def estimate(data: FrequencyData, par: Parametrisation, rows: collections.abc.Se
     ...
 def eta_covariance(par: Parametrisation, cov_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+def excited_lines(data: FrequencyData, ratio: typing.SupportsFloat | typing.SupportsIndex = 100.0) -> list[int]:
+    ...
 def expected_fraction_above_0db(n_rows: typing.SupportsInt | typing.SupportsIndex, n_free: typing.SupportsInt | typing.SupportsIndex, periods: typing.SupportsInt | typing.SupportsIndex) -> tuple[float, tuple[float, float]]:
     ...
 def gsvd_pairs(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], int]:
     ...
 def htf(model: Model, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+    ...
+def htf_estimate(data: FrequencyData, excited: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], branches: typing.SupportsInt | typing.SupportsIndex) -> HtfEstimate:
     ...
 def identify(data: FrequencyData, structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] = [], covariance: bool = True) -> Identification:
     ...

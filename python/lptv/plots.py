@@ -150,3 +150,58 @@ def model_fit(lines, Y, Y_model, noise_std=None, *, w0=None, ax=None):
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     return ax
+
+
+def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60):
+    """The nonparametric HTF branches |G_k| in dB against frequency with +-2 standard deviations
+    (a :class:`lptv.HtfEstimate`), and, given a model, its branches on top (lines through the same
+    frequencies). Branches whose p-value says they stand above the noise are drawn solid, the
+    others faint.
+
+    Parameters
+    ----------
+    est : lptv.HtfEstimate
+    model : lptv.Model, optional
+        Its HTF (:func:`lptv.htf`) at the excited lines, continuous time on lines -L..L with
+        ``guard`` lines beyond the highest branch.
+    hz : bool
+        Frequency axis in Hz instead of rad/s.
+    """
+    from .fds import htf
+
+    ax = _axes(ax)
+    x = est.w / (2 * np.pi) if hz else est.w
+    sig = set(est.significant().tolist())
+    G_model = None
+    if model is not None:
+        lines = [int(l) for l in est.lines]
+        if model.discrete:
+            N = model.samples_per_period
+            G = htf(model, 0, lines)
+            G_model = np.array([[G[(l + k) % N, c] for c, l in enumerate(lines)] for k in est.k])
+        else:
+            L = max(lines) + est.branches + guard
+            G = htf(model, L, lines)
+            G_model = np.array([[G[l + k + L, c] for c, l in enumerate(lines)] for k in est.k])
+    # Where the band reaches zero its lower edge is drawn at a floor 20 dB under the data.
+    floor = 10 ** ((np.nanmin(_db(est.G)) - 20) / 20)
+    for i, k in enumerate(est.k):
+        color = f"C{i % 10}"
+        alpha = 1.0 if k in sig else 0.35
+        mag = np.abs(est.G[i])
+        lo = _db(np.maximum(mag - 2 * est.std[i], floor))
+        hi = _db(mag + 2 * est.std[i])
+        ax.fill_between(x, lo, hi, color=color, alpha=0.15 * alpha, lw=0)
+        ax.plot(x, _db(mag), "o", ms=3.5, mfc="none", color=color, alpha=alpha,
+                label=f"G_{k:+d} (data)" if k else "G_0 (data)")
+        if G_model is not None:
+            ax.plot(x, _db(G_model[i]), "-", lw=1.0, color=color, alpha=alpha)
+    if G_model is not None:
+        ax.plot([], [], "-", color="0.3", lw=1.0, label="model")
+    ax.set_xscale("log")
+    ax.set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
+    ax.set_ylabel("|G_k| (dB)")
+    ax.set_title(f"HTF branches from {est.periods} periods (shaded: +-2 std; faint: within the noise)")
+    ax.legend(fontsize=7, ncol=2)
+    ax.grid(True, which="both", alpha=0.3)
+    return ax

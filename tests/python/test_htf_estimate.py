@@ -1,0 +1,109 @@
+"""The nonparametric HTF (lptv.htf_estimate, METHOD.md section 11) against the model's HTF from the
+NumPy reference (a dense solve of A G = B), within the uncertainty it predicts."""
+import doctest
+
+import numpy as np
+import pytest
+from scipy import stats
+
+import lptv
+import lptv.nonparametric
+from lptv.reference import fds as ref
+
+from conftest import random_model
+
+P = 16
+
+
+def periods(model, lines, N, seed, snr_db=40.0, correlation=0.5):
+    """P steady-state periods excited on `lines`, with white noise on input and output
+    (correlated), SNR `snr_db` on each."""
+    rng = np.random.default_rng([seed, 5])
+    U = np.zeros(N // 2 + 1, complex)
+    U[lines] = np.exp(2j * np.pi * rng.uniform(size=len(lines)))
+    u0 = lptv.time_signal(U, N)
+    # the output below Nyquist: its line N/2 aliases with -N/2 when sampled (not needed here)
+    y0 = lptv.time_signal(lptv.simulate(model, U, lines_out=N // 2 - 1), N)
+    su, sy = u0.std() * 10 ** (-snr_db / 20), y0.std() * 10 ** (-snr_db / 20)
+    nu = rng.standard_normal((P, N))
+    ny = correlation * nu + np.sqrt(1 - correlation ** 2) * rng.standard_normal((P, N))
+    return u0 + su * nu, y0 + sy * ny
+
+
+def true_branches(model, lines, Kh):
+    """G_k(w_l) from the reference HTF: column of input line l, row of output line l + k."""
+    if model.discrete:
+        N = model.samples_per_period
+        G = ref.htf(model, 0, lines)
+        return np.array([[G[(l + k) % N, c] for c, l in enumerate(lines)] for k in range(-Kh, Kh + 1)])
+    L = max(lines) + Kh + 60  # guard lines: the truncation error decays well below the noise
+    G = ref.htf(model, L, lines)
+    return np.array([[G[l + k + L, c] for c, l in enumerate(lines)] for k in range(-Kh, Kh + 1)])
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+@pytest.mark.parametrize("domain", ["ct", "dt"])
+def test_branches_match_the_model_within_their_uncertainty(seed, domain):
+    # Output line l + k also receives the far branches of the neighbouring excited lines: with a
+    # time-varying denominator they decay like depth^|k| (0.2^|k|) but never vanish. Continuous
+    # time: lines 15 apart put those at |k| >= 12 (~1e-8, far below the noise). Discrete time
+    # (N = 16..64 lines): a constant denominator and a numerator with one harmonic give exactly
+    # the branches -1..1, so lines 3 apart suffice.
+    if domain == "ct":
+        model = random_model(seed, domain)
+        N, Kh, lines = 256, 3, list(range(15, 121, 15))
+    else:
+        model = random_model(seed, domain, ka=0, kb=1)
+        N, Kh = model.samples_per_period, 1
+        lines = list(range(2, N // 2 - Kh + 1, 3))
+    u, y = periods(model, lines, N, seed)
+    est = lptv.htf_estimate(u, y, w0=model.w0, ts=model.ts, excited=lines, branches=Kh)
+    assert est.lines.tolist() == lines and est.G.shape == (2 * Kh + 1, len(lines))
+    z2 = np.abs(est.G - true_branches(model, lines, Kh)) ** 2 / est.std ** 2
+    # With variances from P periods each |z|^2 is about F(2, 2(P-1)): the mean over n entries
+    # lies within 5 standard errors of the F's mean (a false alarm ~1e-6 for a sum of n >= 12).
+    n = z2.size
+    f = stats.f(2, 2 * (P - 1))
+    assert abs(z2.mean() - f.mean()) <= 5 * f.std() / np.sqrt(n), z2.mean()
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_only_the_modulated_branches_are_significant(seed):
+    # b_0(t) = 1 + 0.5 cos(w0 t) before an LTI filter: G_k = 0 exactly for |k| > 1.
+    m = lptv.Model([[1.0], [1.0]], [[0.25, 1.0, 0.25]], w0=0.1)
+    lines = list(range(10, 120, 10))
+    u, y = periods(m, lines, 512, seed, snr_db=30.0)
+    est = lptv.htf_estimate(u, y, w0=0.1, branches=3)
+    assert est.lines.tolist() == lines  # found from the input's power
+    assert est.significant().tolist() == [-1, 0, 1]
+    assert np.all(est.p_value[[0, 1, 5, 6]] > 1e-4)
+
+
+def test_lines_too_close_for_the_branches_are_refused():
+    m = lptv.Model([[1.0], [1.0]], [[0.25, 1.0, 0.25]], w0=0.1)
+    u, y = periods(m, [10, 14, 30], 256, 0)
+    with pytest.raises(ValueError, match="10 and 14 are 4 apart; 2 branches on each side need a spacing of more than 4"):
+        lptv.htf_estimate(u, y, w0=0.1, excited=[10, 14, 30], branches=2)
+    with pytest.raises(ValueError, match="within 3 lines of DC"):
+        lptv.htf_estimate(u, y, w0=0.1, excited=[2, 30], branches=3)
+    with pytest.raises(ValueError, match="excited"):
+        lptv.htf_estimate(u, y, w0=0.1, excited=[500], branches=1)
+    with pytest.raises(ValueError, match="branches"):
+        lptv.htf_estimate(u, y, w0=0.1, branches=-1)
+
+
+def test_docstring_examples_run():
+    assert doctest.testmod(lptv.nonparametric, raise_on_error=False).failed == 0
+
+
+def test_plot_draws_every_branch_and_the_model():
+    pytest.importorskip("matplotlib")
+    import lptv.plots as plots
+
+    m = lptv.Model([[1.0], [1.0]], [[0.25, 1.0, 0.25]], w0=0.1)
+    u, y = periods(m, list(range(10, 120, 10)), 512, 0)
+    est = lptv.htf_estimate(u, y, w0=0.1, branches=2)
+    ax = plots.htf_branches(est, m, hz=True)
+    labels = [ln.get_label() for ln in ax.get_lines()]
+    assert sum(lab.endswith("(data)") for lab in labels) == 5 and "model" in labels
+    assert ax.get_xlabel() == "frequency (Hz)"
