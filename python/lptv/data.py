@@ -117,3 +117,21 @@ class FrequencyData:
 
     def __repr__(self):
         return f"lptv.FrequencyData(lines 0..{self.max_line}, periods={self.periods}, w0={self.w0:g})"
+
+
+def frequency_data_of(u, y, w0, ts) -> "FrequencyData":
+    """The data of a call that takes either periods ``u, y`` (with ``w0``, ``ts``) or a
+    :class:`FrequencyData` as ``u``; ``w0``/``ts`` given with a FrequencyData must agree with it."""
+    if isinstance(u, FrequencyData):
+        if y is not None:
+            raise ValueError("y must be omitted when u is a FrequencyData")
+        if w0 is not None and not np.isclose(w0, u.w0):
+            raise ValueError(f"w0={w0} disagrees with the data's w0={u.w0}")
+        if ts is not None and u.ts is not None and not np.isclose(ts, u.ts):
+            raise ValueError(f"ts={ts} disagrees with the data's ts={u.ts}")
+        return u
+    if y is None:
+        raise ValueError("y is missing: pass u and y of shape (P, N), or a FrequencyData")
+    if w0 is None:
+        raise ValueError("w0 is missing: the fundamental of the period (rad/s)")
+    return FrequencyData.from_periods(u, y, w0=w0, ts=ts)

@@ -9,7 +9,7 @@ from typing import Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core
-from .data import FrequencyData
+from .data import FrequencyData, frequency_data_of
 from .model import Model
 from ._validate import as_positive_float
 
@@ -241,21 +241,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if isinstance(u, FrequencyData):
-        if y is not None:
-            raise ValueError("y must be omitted when u is a FrequencyData")
-        data = u
-        if w0 is not None and not np.isclose(w0, data.w0):
-            raise ValueError(f"w0={w0} disagrees with the data's w0={data.w0}")
-        if ts is not None and data.ts is not None and not np.isclose(ts, data.ts):
-            raise ValueError(f"ts={ts} disagrees with the data's ts={data.ts}")
-        ts = data.ts if ts is None else ts
-    else:
-        if y is None:
-            raise ValueError("y is missing: pass u and y of shape (P, N), or a FrequencyData")
-        if w0 is None:
-            raise ValueError("w0 is missing: the fundamental of the period (rad/s)")
-        data = FrequencyData.from_periods(u, y, w0=w0, ts=ts)
+    data = frequency_data_of(u, y, w0, ts)
+    ts = data.ts if ts is None else ts
     for name, v in (("na", na), ("nb", nb)):
         if np.ndim(v) != 0 or int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")

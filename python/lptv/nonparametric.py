@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _core
 from ._validate import as_int
-from .data import FrequencyData
+from .data import frequency_data_of
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     Parameters
     ----------
     u, y : array_like, shape (P, N)
-        P >= 2 steady-state periods, or a :class:`FrequencyData` as ``u`` (no ``y``).
+        P >= 2 steady-state periods, or a :class:`lptv.FrequencyData` as ``u`` (no ``y``).
     w0, ts : float
         The period's fundamental (rad/s) and, for discrete time, the sample time.
     excited : sequence of int, optional
@@ -96,16 +96,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     """
     from scipy import stats
 
-    if isinstance(u, FrequencyData):
-        if y is not None:
-            raise ValueError("y must be omitted when u is a FrequencyData")
-        data = u
-    else:
-        if y is None:
-            raise ValueError("y is missing: pass u and y of shape (P, N), or a FrequencyData")
-        if w0 is None:
-            raise ValueError("w0 is missing: the fundamental of the period (rad/s)")
-        data = FrequencyData.from_periods(u, y, w0=w0, ts=ts)
+    data = frequency_data_of(u, y, w0, ts)
     branches = as_int(branches, "branches", maximum=data.max_line)
     if excited is None:
         lines = [int(v) for v in _core.excited_lines(data._cpp)]
