@@ -6,10 +6,12 @@
 // here); private to the library (namespace detail), shared with the in-tree benchmarks.
 #pragma once
 #include <Eigen/Dense>
+#include <algorithm>
 #include <complex>
 #include <vector>
 
 #include "lptv/model.hpp"
+#include "lptv/structure.hpp"
 
 namespace lptv {
 
@@ -48,6 +50,60 @@ inline T band_entry(const T* c, const T* pw, int order) {
   T v(0);
   for (int n = 0; n <= order; ++n) v += c[n] * pw[n];
   return v;
+}
+
+// The row kernels' side: s_i^n for the 2K+1 lines i = l - k (k = -K..K) that row l uses,
+// n = 0..max(na, nb).
+class RowPowers {
+ public:
+  explicit RowPowers(const Structure& s)
+      : w0_(s.w0), ts_(s.ts), K_(s.kmax()), order_(std::max(s.na, s.nb)),
+        pw_(static_cast<size_t>(2 * K_ + 1) * (order_ + 1)) {}
+  void compute(int l) {
+    for (int k = -K_; k <= K_; ++k) line_powers(line_variable(w0_, ts_, l - k), order_, out(k));
+  }
+  // s_{l-k}^0 .. s_{l-k}^order.
+  const cd* line(int k) const { return &pw_[static_cast<size_t>(K_ + k) * (order_ + 1)]; }
+  cd operator()(int k, int n) const { return line(k)[n]; }
+  int K() const { return K_; }
+
+ private:
+  cd* out(int k) { return &pw_[static_cast<size_t>(K_ + k) * (order_ + 1)]; }
+  double w0_, ts_;
+  int K_, order_;
+  std::vector<cd> pw_;
+};
+
+// theta laid out as Model holds coefficients, K = the structure's kmax on both sides: a is
+// (na+1) x (2K+1), b is (nb+1) x (2K+1), zero where a coefficient has fewer harmonics. A zero
+// term leaves a sum unchanged (up to the sign of an exact zero), so the entries equal the sums
+// over the parameters alone, bit for bit.
+struct HarmonicCoefficients {
+  Eigen::MatrixXcd a, b;
+};
+
+inline HarmonicCoefficients by_harmonic(const Parametrisation& p, const Eigen::VectorXcd& theta) {
+  const Structure& s = p.structure();
+  const int K = s.kmax();
+  HarmonicCoefficients c{Eigen::MatrixXcd::Zero(s.na + 1, 2 * K + 1),
+                         Eigen::MatrixXcd::Zero(s.nb + 1, 2 * K + 1)};
+  for (int q = 0; q < p.n_theta(); ++q) {
+    const Param& pr = p.params()[q];
+    (pr.is_a ? c.a : c.b)(pr.order, K + pr.k) = theta[q];
+  }
+  return c;
+}
+
+// A_{l,i} and B_{l,i} for i = l - k, k = -K..K (index K + k), from row l's powers.
+inline void band_row(const HarmonicCoefficients& c, const RowPowers& pw, std::vector<cd>& A,
+                     std::vector<cd>& B) {
+  const int K = pw.K(), na = static_cast<int>(c.a.rows()) - 1, nb = static_cast<int>(c.b.rows()) - 1;
+  A.resize(2 * K + 1);
+  B.resize(2 * K + 1);
+  for (int k = -K; k <= K; ++k) {
+    A[K + k] = band_entry(c.a.col(K + k).data(), pw.line(k), na);
+    B[K + k] = band_entry(c.b.col(K + k).data(), pw.line(k), nb);
+  }
 }
 
 }  // namespace detail
