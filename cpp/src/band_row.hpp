@@ -15,6 +15,8 @@
 
 namespace lptv {
 
+struct Grid;  // fds.hpp
+
 namespace detail {
 
 // s_i of line i: j i w0 in continuous time (ts == 0), the forward shift exp(j i w0 ts) in
@@ -51,6 +53,11 @@ inline T band_entry(const T* c, const T* pw, int order) {
   for (int n = 0; n <= order; ++n) v += c[n] * pw[n];
   return v;
 }
+
+// A of a continuous-time model in LAPACK band storage (kl = ku = Ka, kl more rows of pivoting
+// workspace): ab[(2 Ka + k) + j * ldab] = A_{j+k,j}. Defined in fds.cpp, whose band solver
+// factorises it; declared here so that the benchmarks' bare band LU factorises the same array.
+std::vector<cd> band_storage_A(const Model& m, const Grid& g);
 
 // The row kernels' side: s_i^n for the 2K+1 lines i = l - k (k = -K..K) that row l uses,
 // n = 0..max(na, nb).

@@ -67,24 +67,22 @@ SpMat build_band(const Model& m, const Grid& g, const Eigen::MatrixXcd& c) {
 SpMat build_A(const Model& m, const Grid& g) { return build_band(m, g, m.a()); }
 SpMat build_B(const Model& m, const Grid& g) { return build_band(m, g, m.b()); }
 
-namespace {
+namespace detail {
 
-// A in LAPACK band storage (kl = ku = Ka): ab[(2K + k) + j * ldab] = A(j + k, j).
 std::vector<cd> band_storage_A(const Model& m, const Grid& g) {
   const int K = m.ka(), na = m.na(), ld = BandLU::ldab(K, K);
   std::vector<cd> ab(static_cast<size_t>(ld) * g.N, cd(0.0, 0.0));
   std::vector<cd> pw(na + 1);
   for (int j = 0; j < g.N; ++j) {
-    detail::line_powers(detail::line_variable(m.w0(), m.ts(), g.line_of(j)), na, pw.data());
+    line_powers(line_variable(m.w0(), m.ts(), g.line_of(j)), na, pw.data());
     for (int k = std::max(-K, -j); k <= std::min(K, g.N - 1 - j); ++k) {
-      ab[(2 * K + k) + static_cast<size_t>(j) * ld] =
-          detail::band_entry(m.a().col(K + k).data(), pw.data(), na);
+      ab[(2 * K + k) + static_cast<size_t>(j) * ld] = band_entry(m.a().col(K + k).data(), pw.data(), na);
     }
   }
   return ab;
 }
 
-}  // namespace
+}  // namespace detail
 
 Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& U) {
   const int K = m.kb(), nb = m.nb();
@@ -113,7 +111,7 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
       throw std::invalid_argument("solver: the band solver needs the continuous-time grid; the "
                                   "discrete-time grid wraps around (use 'klu' or 'umfpack')");
     }
-    band_ = std::make_unique<BandLU>(grid_.N, m.ka(), m.ka(), band_storage_A(m, grid_), label);
+    band_ = std::make_unique<BandLU>(grid_.N, m.ka(), m.ka(), detail::band_storage_A(m, grid_), label);
   } else {
     lu_ = std::make_unique<SparseLU>(build_A(m, grid_), solver_, label);
   }
