@@ -1,5 +1,5 @@
 // The continuous-time FDS's band LU without lptv's conditioning check, for the benchmarks'
-// comparison (not part of lptv): A built the way lptv::Fds builds it for its band solver,
+// comparison (not part of lptv): A from the builder lptv::Fds uses for its band solver,
 // LAPACK's zgbtrf and zgbtrs, nothing else - the floor under what the FDS can cost with these
 // routines.
 #pragma once
@@ -9,28 +9,16 @@
 #include <string>
 #include <vector>
 
+#include "band_row.hpp"  // lptv's private band builders (cpp/src)
 #include "lptv/band_lu.hpp"
 #include "lptv/fds.hpp"
 
 namespace bench {
 
-// A in LAPACK band storage (kl = ku = Ka, kl rows of pivoting workspace), built from the model
-// column by column the way lptv::Fds builds it for its band solver (that builder is internal to
-// fds.cpp).
+// A in LAPACK band storage (kl = ku = Ka, kl rows of pivoting workspace): the array lptv::Fds
+// hands its band solver, from the same (private) builder.
 inline std::vector<lptv::cd> band_storage(const lptv::Model& m, const lptv::Grid& g) {
-  const int K = m.ka(), na = m.na(), ld = lptv::BandLU::ldab(K, K);
-  std::vector<lptv::cd> ab(static_cast<size_t>(ld) * g.N, lptv::cd(0.0, 0.0));
-  std::vector<lptv::cd> pw(na + 1);
-  for (int j = 0; j < g.N; ++j) {
-    for (int n = 0; n <= na; ++n) pw[n] = lptv::line_power(m, g, g.line_of(j), n);
-    for (int k = -K; k <= K; ++k) {
-      if (j + k < 0 || j + k >= g.N) continue;
-      lptv::cd v(0.0, 0.0);
-      for (int n = 0; n <= na; ++n) v += m.a()(n, K + k) * pw[n];
-      ab[(2 * K + k) + static_cast<size_t>(j) * ld] = v;
-    }
-  }
-  return ab;
+  return lptv::detail::band_storage_A(m, g);
 }
 
 class BareBandLU {

@@ -80,11 +80,7 @@ Eigen::MatrixXd r_factor_range(const FrequencyData& d, const Parametrisation& p,
     for (int r = 0; r < m; ++r) {
       const int l = rows[b0 + r];
       pw.compute(l);
-      for (int q = 0; q < p.n_theta(); ++q) {
-        const Param& pr = p.params()[q];
-        const int i = l - pr.k;
-        jrow[q] = pw(pr.k, pr.order) * (pr.is_a ? X.Y(i) : -X.U(i));
-      }
+      detail::jacobian_row(p, X, pw, l, jrow.data());
       xrow.setZero();
       for (const auto& e : entries) xrow[e.c] += jrow[e.p] * e.v;
       const double sw = weights.size() ? std::sqrt(weights[b0 + r]) : 1.0;

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "band_row.hpp"
 #include "lptv/errors.hpp"
 
 namespace lptv {
@@ -32,12 +33,8 @@ Grid make_grid(const Model& m, int L) {
 }
 
 cd line_power(const Model& m, const Grid& g, int line, int n) {
-  const double w = m.w0() * line;
-  const cd s = m.discrete() ? std::polar(1.0, w * m.ts()) : cd(0.0, w);
   (void)g;
-  cd p(1.0, 0.0);
-  for (int i = 0; i < n; ++i) p *= s;
-  return p;
+  return detail::line_power(detail::line_variable(m.w0(), m.ts(), line), n);
 }
 
 namespace {
@@ -51,12 +48,11 @@ SpMat build_band(const Model& m, const Grid& g, const Eigen::MatrixXcd& c) {
   std::vector<cd> pw(order + 1);
   for (int col = 0; col < g.N; ++col) {
     const int i = g.line_of(col);
-    for (int n = 0; n <= order; ++n) pw[n] = line_power(m, g, i, n);
+    detail::line_powers(detail::line_variable(m.w0(), m.ts(), i), order, pw.data());
     for (int k = -K; k <= K; ++k) {
       const int row = g.index_of(i + k);
       if (row < 0) continue;
-      cd v(0.0, 0.0);
-      for (int n = 0; n <= order; ++n) v += c(n, K + k) * pw[n];
+      const cd v = detail::band_entry(c.col(K + k).data(), pw.data(), order);
       if (v != cd(0.0, 0.0)) trip.emplace_back(row, col, v);
     }
   }
@@ -71,28 +67,22 @@ SpMat build_band(const Model& m, const Grid& g, const Eigen::MatrixXcd& c) {
 SpMat build_A(const Model& m, const Grid& g) { return build_band(m, g, m.a()); }
 SpMat build_B(const Model& m, const Grid& g) { return build_band(m, g, m.b()); }
 
-namespace {
+namespace detail {
 
-// A in LAPACK band storage (kl = ku = Ka): ab[(2K + k) + j * ldab] = A(j + k, j).
 std::vector<cd> band_storage_A(const Model& m, const Grid& g) {
   const int K = m.ka(), na = m.na(), ld = BandLU::ldab(K, K);
   std::vector<cd> ab(static_cast<size_t>(ld) * g.N, cd(0.0, 0.0));
   std::vector<cd> pw(na + 1);
   for (int j = 0; j < g.N; ++j) {
-    const int i = g.line_of(j);
-    for (int n = 0; n <= na; ++n) pw[n] = line_power(m, g, i, n);
-    for (int k = -K; k <= K; ++k) {
-      const int row = j + k;
-      if (row < 0 || row >= g.N) continue;
-      cd v(0.0, 0.0);
-      for (int n = 0; n <= na; ++n) v += m.a()(n, K + k) * pw[n];
-      ab[(2 * K + k) + static_cast<size_t>(j) * ld] = v;
+    line_powers(line_variable(m.w0(), m.ts(), g.line_of(j)), na, pw.data());
+    for (int k = std::max(-K, -j); k <= std::min(K, g.N - 1 - j); ++k) {
+      ab[(2 * K + k) + static_cast<size_t>(j) * ld] = band_entry(m.a().col(K + k).data(), pw.data(), na);
     }
   }
   return ab;
 }
 
-}  // namespace
+}  // namespace detail
 
 Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& U) {
   const int K = m.kb(), nb = m.nb();
@@ -101,12 +91,11 @@ Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& 
   for (int j = 0; j < g.N; ++j) {
     if (U.row(j).isZero(0.0)) continue;
     const int i = g.line_of(j);
-    for (int n = 0; n <= nb; ++n) pw[n] = line_power(m, g, i, n);
+    detail::line_powers(detail::line_variable(m.w0(), m.ts(), i), nb, pw.data());
     for (int k = -K; k <= K; ++k) {
       const int row = g.index_of(i + k);
       if (row < 0) continue;
-      cd v(0.0, 0.0);
-      for (int n = 0; n <= nb; ++n) v += m.b()(n, K + k) * pw[n];
+      const cd v = detail::band_entry(m.b().col(K + k).data(), pw.data(), nb);
       if (v != cd(0.0, 0.0)) out.row(row) += v * U.row(j);
     }
   }
@@ -122,7 +111,7 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
       throw std::invalid_argument("solver: the band solver needs the continuous-time grid; the "
                                   "discrete-time grid wraps around (use 'klu' or 'umfpack')");
     }
-    band_ = std::make_unique<BandLU>(grid_.N, m.ka(), m.ka(), band_storage_A(m, grid_), label);
+    band_ = std::make_unique<BandLU>(grid_.N, m.ka(), m.ka(), detail::band_storage_A(m, grid_), label);
   } else {
     lu_ = std::make_unique<SparseLU>(build_A(m, grid_), solver_, label);
   }
@@ -135,15 +124,11 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   Eigen::VectorXd mag = Eigen::VectorXd::Zero(grid_.N);
   std::vector<double> wn(na + 1);
   for (int j = 0; j < grid_.N; ++j) {
-    const double w = std::abs(line_power(m, grid_, grid_.line_of(j), 1));
-    wn[0] = 1.0;
-    for (int n = 1; n <= na; ++n) wn[n] = wn[n - 1] * w;
+    const int i = grid_.line_of(j);
+    detail::line_powers(std::abs(detail::line_variable(m.w0(), m.ts(), i)), na, wn.data());
     for (int k = -K; k <= K; ++k) {
-      const int row = grid_.index_of(grid_.line_of(j) + k);
-      if (row < 0) continue;
-      double t = 0;
-      for (int n = 0; n <= na; ++n) t += absa(n, K + k) * wn[n];
-      mag[row] += t;
+      const int row = grid_.index_of(i + k);
+      if (row >= 0) mag[row] += detail::band_entry(absa.col(K + k).data(), wn.data(), na);
     }
   }
   Eigen::VectorXcd b(grid_.N);

@@ -12,24 +12,16 @@
 namespace lptv {
 
 cd line_power(const Structure& s, int line, int n) {
-  const double w = s.w0 * line;
-  const cd z = s.ts > 0 ? std::polar(1.0, w * s.ts) : cd(0.0, w);
-  cd p(1.0, 0.0);
-  for (int i = 0; i < n; ++i) p *= z;
-  return p;
+  return detail::line_power(detail::line_variable(s.w0, s.ts, line), n);
 }
 
 Eigen::MatrixXcd jacobian(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows) {
   const detail::Lines X{d};
-  const Structure& s = p.structure();
-  Eigen::MatrixXcd J(rows.size(), p.n_theta());
+  Eigen::Matrix<cd, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> J(rows.size(), p.n_theta());
+  detail::RowPowers pw(p.structure());
   for (size_t r = 0; r < rows.size(); ++r) {
-    for (int q = 0; q < p.n_theta(); ++q) {
-      const Param& pr = p.params()[q];
-      const int i = rows[r] - pr.k;
-      const cd f = line_power(s, i, pr.order);
-      J(r, q) = pr.is_a ? f * X.Y(i) : -f * X.U(i);
-    }
+    pw.compute(rows[r]);
+    detail::jacobian_row(p, X, pw, rows[r], J.row(static_cast<Eigen::Index>(r)).data());
   }
   return J;
 }
@@ -42,11 +34,12 @@ template <class F>
 void for_each_row(const Parametrisation& p, const std::vector<int>& rows, const Eigen::VectorXcd& theta,
                   F&& f) {
   detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int) {
+    const detail::HarmonicCoefficients c = detail::by_harmonic(p, theta);
     detail::RowPowers pw(p.structure());
     std::vector<cd> A, B;
     for (size_t r = begin; r < end; ++r) {
       pw.compute(rows[r]);
-      detail::band_row(p, theta, pw, A, B);
+      detail::band_row(c, pw, A, B);
       f(r, pw, A, B);
     }
   });

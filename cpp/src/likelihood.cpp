@@ -93,11 +93,12 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
   f.e.resize(static_cast<size_t>(R) * W);
   f.r = Eigen::VectorXd::Zero(n);
   const detail::Lines X{d_};
+  const detail::HarmonicCoefficients c = detail::by_harmonic(p_, theta);
   detail::RowPowers pw(p_.structure());
   std::vector<cd> A, B;
   for (int r = 0; r < R; ++r) {
     pw.compute(sorted_[r]);
-    detail::band_row(p_, theta, pw, A, B);
+    detail::band_row(c, pw, A, B);
     for (int k = -K_; k <= K_; ++k) {
       const int i = sorted_[r] - k;
       Factor::Entry& en = f.e[static_cast<size_t>(r) * W + K_ + k];
@@ -211,11 +212,7 @@ Eigen::MatrixXd ExactLikelihood::real_jacobian(const FrequencyData& x) const {
   Eigen::RowVectorXcd j(p_.n_theta());
   for (int r = 0; r < R; ++r) {
     pw.compute(sorted_[r]);
-    for (int q = 0; q < p_.n_theta(); ++q) {
-      const Param& pr = p_.params()[q];
-      const int i = sorted_[r] - pr.k;
-      j[q] = pw(pr.k, pr.order) * (pr.is_a ? X.Y(i) : -X.U(i));
-    }
+    detail::jacobian_row(p_, X, pw, sorted_[r], j.data());
     const Eigen::RowVectorXcd jt = j * T;
     out.row(2 * r) = jt.real();
     out.row(2 * r + 1) = jt.imag();

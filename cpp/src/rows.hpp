@@ -1,4 +1,5 @@
-// Private helpers of the row-wise kernels (jacobian.cpp, estimators.cpp).
+// Private helpers of the row-wise kernels (jacobian.cpp, estimators.cpp, likelihood.cpp); the
+// band entries and line powers of a row come from band_row.hpp.
 #pragma once
 #include <dlfcn.h>
 
@@ -6,48 +7,11 @@
 #include <thread>
 #include <vector>
 
+#include "band_row.hpp"
 #include "lptv/jacobian.hpp"
 
 namespace lptv {
 namespace detail {
-
-// s_i^n for the 2K+1 lines i = l - k (k = -K..K) a row l uses, n = 0..order;
-// s = j i w0 (continuous time) or exp(j i w0 ts) (discrete time).
-class RowPowers {
- public:
-  RowPowers(const Structure& s) : s_(s), K_(s.kmax()), order_(std::max(s.na, s.nb)) {
-    pw_.resize((2 * K_ + 1) * (order_ + 1));
-  }
-  void compute(int l) {
-    for (int k = -K_; k <= K_; ++k) {
-      const int i = l - k;
-      const double w = s_.w0 * i;
-      const cd z = s_.ts > 0 ? std::polar(1.0, w * s_.ts) : cd(0.0, w);
-      cd* p = &pw_[(K_ + k) * (order_ + 1)];
-      p[0] = 1.0;
-      for (int n = 1; n <= order_; ++n) p[n] = p[n - 1] * z;
-    }
-  }
-  cd operator()(int k, int n) const { return pw_[(K_ + k) * (order_ + 1) + n]; }
-  int K() const { return K_; }
-
- private:
-  const Structure& s_;
-  int K_, order_;
-  std::vector<cd> pw_;
-};
-
-// A_{l,i} and B_{l,i} for i = l - k, k = -K..K (index K + k), from the row's powers.
-inline void band_row(const Parametrisation& p, const Eigen::VectorXcd& theta, const detail::RowPowers& pw,
-              std::vector<cd>& A, std::vector<cd>& B) {
-  const int K = pw.K();
-  A.assign(2 * K + 1, cd(0.0, 0.0));
-  B.assign(2 * K + 1, cd(0.0, 0.0));
-  for (int q = 0; q < p.n_theta(); ++q) {
-    const Param& pr = p.params()[q];
-    (pr.is_a ? A : B)[K + pr.k] += theta[q] * pw(pr.k, pr.order);
-  }
-}
 
 // Line values with X_{-l} = conj(X_l); the statistics of a conjugate line follow.
 struct Lines {
@@ -59,6 +23,17 @@ struct Lines {
   // E{dY_l conj(dU_l)}; on a conjugate line it is the conjugate.
   cd covYU(int l) const { return l >= 0 ? d.covYU[l] : std::conj(d.covYU[-l]); }
 };
+
+// Row l of the Jacobian, J[l, q] = +s_{l-k}^n Y_{l-k} (a-parameters), -s_{l-k}^n U_{l-k}
+// (b-parameters), from the row's powers (pw.compute(l) done).
+inline void jacobian_row(const Parametrisation& p, const Lines& X, const RowPowers& pw, int l, cd* out) {
+  for (int q = 0; q < p.n_theta(); ++q) {
+    const Param& pr = p.params()[q];
+    const int i = l - pr.k;
+    const cd f = pw(pr.k, pr.order);
+    out[q] = pr.is_a ? f * X.Y(i) : -f * X.U(i);
+  }
+}
 
 // Runs f(begin, end, part) over [0, n) in up to two parts on two threads when n is large
 // enough to pay for a thread (the machines this targets have few cores; the kernels are

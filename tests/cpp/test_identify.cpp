@@ -5,6 +5,7 @@
 #include "lptv/estimators.hpp"
 #include "lptv/fds.hpp"
 #include "lptv/gsvd.hpp"
+#include "lptv/jacobian.hpp"
 #include "lptv/multisine.hpp"
 
 using lptv::cd;
@@ -106,6 +107,42 @@ TEST_CASE("the residue of the true model vanishes on noise-free data", "[jacobia
   REQUIRE(e.cwiseAbs().maxCoeff() < 1e-13 * d.Y.cwiseAbs().maxCoeff());
   const Eigen::VectorXcd e2 = lptv::jacobian(d, p, rows) * theta;
   REQUIRE((e - e2).cwiseAbs().maxCoeff() < 1e-14);
+}
+
+TEST_CASE("the FDS and the row kernels build bitwise identical band entries", "[jacobian]") {
+  const lptv::Model ct = lptv_model();
+  Eigen::MatrixXcd a_dt = ct.a();
+  a_dt(0, 1) = 0.3, a_dt(1, 1) = -0.5;  // z^2 - 0.5 z + 0.3: poles inside the unit circle
+  const lptv::Model dt(a_dt, ct.b(), 2 * M_PI / 64, 1.0);
+  for (const lptv::Model& m : {ct, dt}) {
+    const lptv::FrequencyData d = noiseless(m, 30, 4);
+    lptv::Structure s = structure_of(m);
+    s.ts = m.ts();
+    const lptv::Parametrisation p(s);
+    const auto rows = lptv::default_rows(p, d.max_line());
+    const Eigen::VectorXcd theta = p.theta_from_model(m);
+    const lptv::Grid g = lptv::make_grid(m, d.max_line());
+    const lptv::SpMat A = lptv::build_A(m, g), B = lptv::build_B(m, g);
+    const Eigen::MatrixXcd J = lptv::jacobian(d, p, rows);
+    const Eigen::VectorXcd e = lptv::residue(d, p, rows, theta);
+    const int K = m.kmax();
+    for (size_t r = 0; r < rows.size(); ++r) {
+      const int l = rows[r];
+      cd v(0.0, 0.0);  // row l of A Y - B U from the FDS's matrices, in the residue's order
+      for (int k = -K; k <= K; ++k) {
+        const int i = l - k;
+        v += A.coeff(g.index_of(l), g.index_of(i)) * d.Y[i] - B.coeff(g.index_of(l), g.index_of(i)) * d.U[i];
+      }
+      REQUIRE(e[static_cast<Eigen::Index>(r)] == v);
+      for (int q = 0; q < p.n_theta(); ++q) {
+        const lptv::Param& pr = p.params()[q];
+        const int i = l - pr.k;
+        const cd f = lptv::line_power(s, i, pr.order);
+        REQUIRE(f == lptv::line_power(m, g, i, pr.order));
+        REQUIRE(J(static_cast<Eigen::Index>(r), q) == (pr.is_a ? f * d.Y[i] : -f * d.U[i]));
+      }
+    }
+  }
 }
 
 TEST_CASE("rows that need missing lines are refused", "[jacobian]") {
