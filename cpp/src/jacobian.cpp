@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
