@@ -17,3 +17,4 @@ void bind_structure(py::module_& m);
 void bind_jacobian(py::module_& m);
 void bind_likelihood(py::module_& m);
 void bind_estimators(py::module_& m);
+void bind_floquet(py::module_& m);

@@ -8,6 +8,7 @@ The public API:
 - :class:`FrequencyData`, :func:`identify` - noise model and estimators (LS, TLS, GTLS, WGTLS,
   SML on the exact likelihood) with the covariance of the estimate;
 - :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
+- :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
 - :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
@@ -17,6 +18,7 @@ from .fds import SimulationResult, TruncationWarning, band_matrices, htf, simula
 from .data import FrequencyData
 from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
 from .uncertainty import CramerRaoBound, crb
+from .floquet import FloquetResult, floquet
 from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
@@ -25,7 +27,7 @@ from .multisine import Multisine, multisine, spectrum, time_signal
 __version__ = "0.1.0"
 
 __all__ = [
-    "CramerRaoBound", "FrequencyData", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
-    "band_matrices", "crb", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
+    "CramerRaoBound", "FloquetResult", "FrequencyData", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
+    "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf",
     "identify", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
 ]
