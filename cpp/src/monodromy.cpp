@@ -99,7 +99,7 @@ Eigen::MatrixXd monodromy(const Model& m, int steps) {
   const int na = m.na();
   if (na == 0) return Eigen::MatrixXd(0, 0);
   const double T0 = 2.0 * M_PI / m.w0();
-  // Fourth-order Magnus step (Blanes, Casas, Oteo, Ros, Phys. Rep. 470 (2009), sec. 5):
+  // Fourth-order Magnus step (Blanes, Casas, Oteo, Ros, Phys. Rep. 470 (2009) 151-238):
   // Omega = h/2 (F1 + F2) + sqrt(3) h^2 / 12 [F2, F1], F1, F2 at the Gauss points
   // t + (1/2 -+ sqrt(3)/6) h. The method is symmetric, so its global error has only even
   // powers of h and one Richardson step (16 Phi_{h/2} - Phi_h) / 15 makes it sixth order.
