@@ -8,6 +8,8 @@
 And what lptv.simulate and lptv.identify do with an unstable periodic system.
 Tolerances: the ``floquet_tol`` fixture (conftest.py, Floquet block).
 """
+import doctest
+import importlib
 import itertools
 import re
 from pathlib import Path
@@ -294,3 +296,10 @@ def test_readme_mathieu_example_runs():
     ns = {}
     exec(compile(blocks[0], "README.md", "exec"), ns)
     assert ns["f"].is_stable is False
+
+
+def test_docstring_examples_run():
+    # lptv.floquet is the function once the package is imported; the module is in sys.modules.
+    module = importlib.import_module("lptv.floquet")
+    result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
