@@ -3,7 +3,7 @@
 #include "lptv/errors.hpp"
 
 PYBIND11_MODULE(_core, m) {
-  m.doc() = "lptv compiled core: model, multisines, frequency-domain simulator, estimators";
+  m.doc() = "lptv compiled core: model, multisines, frequency-domain simulator, estimators, Floquet stability";
   // std::invalid_argument becomes ValueError by pybind11's default translation.
   static py::exception<lptv::NumericalError> numerical_error(m, "NumericalError", PyExc_ArithmeticError);
   py::register_exception_translator([](std::exception_ptr p) {
@@ -22,4 +22,5 @@ PYBIND11_MODULE(_core, m) {
   bind_likelihood(m);
   bind_estimators(m);
   bind_htf_estimate(m);
+  bind_floquet(m);
 }

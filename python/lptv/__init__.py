@@ -9,6 +9,7 @@ The public API:
   SML on the exact likelihood) with the covariance of the estimate;
 - :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
 - :func:`htf_estimate` - the harmonic transfer function's branches from data, without a model;
+- :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
 - :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
@@ -19,6 +20,7 @@ from .data import FrequencyData
 from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
 from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
+from .floquet import FloquetResult, floquet
 from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
@@ -27,7 +29,7 @@ from .multisine import Multisine, multisine, spectrum, time_signal
 __version__ = "0.1.0"
 
 __all__ = [
-    "CramerRaoBound", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
-    "band_matrices", "crb", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
+    "CramerRaoBound", "FloquetResult", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
+    "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
     "identify", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
 ]

@@ -1,5 +1,5 @@
 """
-lptv compiled core: model, multisines, frequency-domain simulator, estimators
+lptv compiled core: model, multisines, frequency-domain simulator, estimators, Floquet stability
 """
 from __future__ import annotations
 import collections.abc
@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'jacobian', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -310,6 +310,37 @@ class HtfEstimate:
     @property
     def variance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
+class Floquet:
+    """
+    Characteristic multipliers and Floquet exponents (lptv::floquet).
+    """
+    @property
+    def convergence(self) -> float:
+        ...
+    @property
+    def error_estimate(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def exponents(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def harmonics(self) -> int:
+        ...
+    @property
+    def is_stable(self) -> bool:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def multipliers(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def spectral_radius(self) -> float:
+        ...
+    @property
+    def truncation(self) -> int:
+        ...
 def band_matrix(model: Model, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
 def column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -330,6 +361,10 @@ def excited_lines(data: FrequencyData, ratio: typing.SupportsFloat | typing.Supp
     ...
 def expected_fraction_above_0db(n_rows: typing.SupportsInt | typing.SupportsIndex, n_free: typing.SupportsInt | typing.SupportsIndex, periods: typing.SupportsInt | typing.SupportsIndex) -> tuple[float, tuple[float, float]]:
     ...
+def floquet(model: Model, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-11, min_truncation: typing.SupportsInt | typing.SupportsIndex = 8, max_truncation: typing.SupportsInt | typing.SupportsIndex = 256) -> Floquet:
+    """
+    Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).
+    """
 def gsvd_pairs(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], int]:
     ...
 def htf(model: Model, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -340,6 +375,11 @@ def identify(data: FrequencyData, structure: Structure, method: str = 'wgtls', t
     ...
 def jacobian(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
+def monodromy(model: Model, steps: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps
+    and Richardson) or of the one-step companion matrices (discrete time).
+    """
 def multisine_spectrum(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     ...
 def real_column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:

@@ -63,6 +63,43 @@ def paper_model() -> Model:
     return Model(a, b, w0=PAPER_W0)
 
 
+def mathieu_model(zeta: float = 0.02, wn: float = 1.0, eps: float = 0.1, w0: float = 2.0) -> Model:
+    """The damped Mathieu equation y'' + 2 zeta wn y' + wn^2 (1 + eps cos(w0 t)) y = u.
+
+    The example where the frozen poles say stable and Floquet theory says unstable (METHOD.md
+    section 12): for 0 < zeta < 1 and |eps| < 1 - zeta^2 every frozen pole has real part
+    -zeta wn, but with the pump w0 near 2 wn the stiffness modulation feeds the oscillation
+    (parametric resonance) once eps exceeds about 2 sqrt((1 - (w0 / 2 wn)^2)^2 + (zeta w0 / wn)^2),
+    i.e. 4 zeta at w0 = 2 wn (first-order harmonic balance for a solution of period 2 T0). The
+    defaults (zeta = 0.02, eps = 0.1 = 1.25 * 4 zeta, w0 = 2 wn) are unstable.
+
+    Returns
+    -------
+    lptv.Model
+        na = 2, nb = 0, one harmonic on a_0: a = [[wn^2 eps/2, wn^2, wn^2 eps/2], [0, 2 zeta wn,
+        0], [0, 1, 0]], b = [[1]].
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import mathieu_model
+    >>> m = mathieu_model(zeta=0.02, wn=1.0, eps=0.1, w0=2.0)
+    >>> np.unique(lptv.frozen_poles(m, np.linspace(0, m.period, 9)).real.round(12))
+    array([-0.02])
+    >>> lptv.floquet(m).is_stable
+    False
+    """
+    for name, v in (("zeta", zeta), ("wn", wn), ("eps", eps), ("w0", w0)):
+        if not np.isfinite(v):
+            raise ValueError(f"{name} must be finite, got {v!r}")
+    if wn <= 0:
+        raise ValueError(f"wn must be positive (rad/s), got {wn!r}")
+    k = wn ** 2
+    a = np.array([[k * eps / 2, k, k * eps / 2], [0.0, 2 * zeta * wn, 0.0], [0.0, 1.0, 0.0]],
+                 dtype=complex)
+    return Model(a, [[1.0]], w0=w0)
+
+
 def paper_multisine(seed: int = 0, n_samples: int = PAPER_N):
     """The paper-like excitation: lines 10, 20, ..., 240, amplitude sqrt(2/24) each (rms 1)."""
     return multisine(PAPER_EXCITED, n_samples, amplitudes=np.sqrt(2.0 / PAPER_EXCITED.size),

@@ -45,7 +45,10 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
              full_output: bool = False):
     """Steady-state output spectrum of ``model`` for the input spectrum ``U``.
 
-    Solves the band system ``A Y = B U`` (METHOD.md eq. 5) with one sparse LU.
+    Solves the band system ``A Y = B U`` (METHOD.md eq. 5) with one sparse LU. The result is
+    the periodic solution of the equation, which exists and is unique whenever no Floquet
+    multiplier equals 1, stable or not: for an unstable system (``lptv.floquet(model).is_stable``
+    is False) it is still returned, though the system never settles into it.
 
     Parameters
     ----------

@@ -237,3 +237,46 @@ def id_tol():
         NOISELESS_COND_MAX=ID_NOISELESS_COND_MAX,
         SELF_CHECK=ID_SELF_CHECK, MC_DRAWS=ID_MC_DRAWS, MC_SIGMAS=ID_MC_SIGMAS,
         FRACTION_DRAWS=ID_FRACTION_DRAWS, FRACTION=ID_FRACTION)
+
+
+# ==================================================================================================
+# Floquet stability: tests/python/test_floquet.py. Tolerances of that file only.
+# ==================================================================================================
+
+# Hill's multipliers against the eigenvalues of the product of matrix exponentials
+# (lptv.floquet.monodromy, sixth order), relative to ||Phi||_2: the product with 2000 steps is
+# within ~1e-13 ||Phi|| of the exact Phi (the test checks ||Phi_2000 - Phi_4000|| <=
+# FLOQUET_PRODUCT_STEP ||Phi||), eig(Phi) adds about eps ||Phi|| kappa_i with the eigenvalue
+# condition numbers kappa_i <= FLOQUET_KAPPA_MAX (checked), and Hill's exponents carry at
+# most their error_estimate (1e-13 .. 1e-5 relative, the large ones only for multipliers many
+# orders below the largest, so below 1e-13 ||Phi|| in absolute terms). 1e-10 leaves two
+# orders of margin; measured: 2e-15 .. 3e-14.
+FLOQUET_VS_PRODUCT = 1e-10
+FLOQUET_PRODUCT_STEP = 1e-12
+FLOQUET_KAPPA_MAX = 1e3
+
+# The monodromy of lptv.timedomain's CVODE shooting, in units of its rtol, relative to
+# ||Phi||_2: CVODE keeps each step's local error below rtol |x| + atol; over one period of a
+# modestly damped model (|mu| >= 0.05, so nothing decays below atol) the global error is a
+# modest multiple of rtol. Measured 1-14 rtol over 8 models at rtol 1e-8, 1e-10, 1e-12.
+FLOQUET_VS_CVODE_RTOLS = 1e3
+FLOQUET_CVODE_RTOL = 1e-12
+
+# LTI: ln(mu) = p T0 from Hill's block-diagonal matrix carries eps ||H|| T0 kappa (||H|| <= M w0
+# + ||F|| ~ 30, T0 <= 63, kappa <= 10 for these poles): 4e-12; numpy.roots adds eps kappa.
+# Relative error of each multiplier; measured <= 1e-13.
+FLOQUET_LTI = 1e-11
+
+# Discrete time, the core's product against NumPy's: both round each of the N <= 64 steps, so
+# they differ by about the bound the core reports (error_estimate, kappa_i ||E|| / |mu_i|);
+# twice it, plus 64 eps ||Phi|| for the two evaluations of a_n[k]. Measured <= 0.5 of the bound.
+FLOQUET_DT_BOUND_FACTOR = 2.0
+
+
+@pytest.fixture(scope="session")
+def floquet_tol():
+    """The Floquet tolerances above as one namespace."""
+    return SimpleNamespace(
+        EPS=EPS, VS_PRODUCT=FLOQUET_VS_PRODUCT, PRODUCT_STEP=FLOQUET_PRODUCT_STEP,
+        KAPPA_MAX=FLOQUET_KAPPA_MAX, VS_CVODE_RTOLS=FLOQUET_VS_CVODE_RTOLS,
+        CVODE_RTOL=FLOQUET_CVODE_RTOL, LTI=FLOQUET_LTI, DT_BOUND_FACTOR=FLOQUET_DT_BOUND_FACTOR)

@@ -1,0 +1,133 @@
+// The monodromy matrix by products: of matrix exponentials (continuous time) and of the
+// one-step companion matrices (discrete time); the checks of a_na that floquet.cpp shares.
+#include "monodromy.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <unsupported/Eigen/MatrixFunctions>
+#include <vector>
+
+#include "lptv/errors.hpp"
+#include "lptv/floquet.hpp"
+
+namespace lptv {
+namespace detail {
+
+void check_leading_ct(const Model& m) {
+  const int na = m.na();
+  const double T0 = 2.0 * M_PI / m.w0();
+  // a_na(t) is a trigonometric polynomial of degree Ka: 256 points per harmonic resolve it.
+  const int n = 256 * (m.ka() + 1) + 1;
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(n, 0.0, T0);
+  const Eigen::VectorXd v = evaluate_fourier(m.a().row(na), m.w0(), t).col(0);
+  const double vmax = v.cwiseAbs().maxCoeff();
+  for (int i = 0; i < n; ++i) {
+    const bool flips = i > 0 && std::signbit(v[i]) != std::signbit(v[i - 1]);
+    if (std::abs(v[i]) <= 1e-12 * vmax || flips) {
+      // Where it crosses zero (linear interpolation over the grid step), else the sample.
+      const double tz = flips ? t[i - 1] + (t[i] - t[i - 1]) * v[i - 1] / (v[i - 1] - v[i]) : t[i];
+      std::ostringstream msg;
+      msg << "a: the leading coefficient a_" << na << "(t) vanishes near t = " << tz << " s (period "
+          << T0 << " s); the companion form x' = F(t) x needs a_na(t) != 0 over the whole period";
+      throw std::invalid_argument(msg.str());
+    }
+  }
+}
+
+// The one-step companion matrices' last rows -a_n[k] / a_na[k] (N x na) of a discrete-time
+// model, after checking that a_na[k] vanishes at no sample.
+Eigen::MatrixXd dt_last_rows(const Model& m) {
+  const int N = m.samples_per_period(), na = m.na();
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(N, 0.0, (N - 1) * m.ts());
+  const Eigen::MatrixXd a = m.a_at(t);
+  const double amax = a.col(na).cwiseAbs().maxCoeff();
+  Eigen::MatrixXd rows(N, na);
+  for (int k = 0; k < N; ++k) {
+    if (std::abs(a(k, na)) <= 1e-14 * amax) {
+      std::ostringstream msg;
+      msg << "a: the leading coefficient a_" << na << "[k] vanishes at sample k = " << k
+          << "; the recursion cannot be solved for y[k + " << na << "] there";
+      throw std::invalid_argument(msg.str());
+    }
+    for (int n = 0; n < na; ++n) rows(k, n) = -a(k, n) / a(k, na);
+  }
+  return rows;
+}
+
+DtProduct dt_product(const Model& m) {
+  const int na = m.na();
+  const Eigen::MatrixXd rows = dt_last_rows(m);
+  const int N = static_cast<int>(rows.rows());
+  auto step = [&](int k) {
+    Eigen::MatrixXd Ck = Eigen::MatrixXd::Zero(na, na);
+    for (int r = 0; r + 1 < na; ++r) Ck(r, r + 1) = 1.0;
+    Ck.row(na - 1) = rows.row(k);
+    return Ck;
+  };
+  // Forward products P_k = C_{k-1}..C_0 and backward S_k = C_{N-1}..C_k: rounding in step k
+  // (na eps |C_k| |P_k| at most) reaches Phi through S_{k+1}.
+  std::vector<double> before(N), after(N + 1);
+  Eigen::MatrixXd P = Eigen::MatrixXd::Identity(na, na);
+  for (int k = 0; k < N; ++k) {
+    before[k] = P.norm();
+    P = step(k) * P;
+  }
+  Eigen::MatrixXd S = Eigen::MatrixXd::Identity(na, na);
+  after[N] = S.norm();
+  DtProduct out;
+  for (int k = N - 1; k >= 0; --k) {
+    const Eigen::MatrixXd Ck = step(k);
+    out.error += na * std::numeric_limits<double>::epsilon() * after[k + 1] * Ck.norm() * before[k];
+    S = S * Ck;
+    after[k] = S.norm();
+  }
+  out.Phi = P;
+  if (!out.Phi.allFinite()) throw NumericalError("the product of the one-step matrices overflowed");
+  return out;
+}
+
+}  // namespace detail
+
+Eigen::MatrixXd monodromy(const Model& m, int steps) {
+  if (m.discrete()) return detail::dt_product(m).Phi;
+  if (steps < 1 || steps > (1 << 28)) {
+    throw std::invalid_argument("steps must be between 1 and 2^28, got " + std::to_string(steps));
+  }
+  detail::check_leading_ct(m);
+  const int na = m.na();
+  if (na == 0) return Eigen::MatrixXd(0, 0);
+  const double T0 = 2.0 * M_PI / m.w0();
+  // Fourth-order Magnus step (Blanes, Casas, Oteo, Ros, Phys. Rep. 470 (2009) 151-238):
+  // Omega = h/2 (F1 + F2) + sqrt(3) h^2 / 12 [F2, F1], F1, F2 at the Gauss points
+  // t + (1/2 -+ sqrt(3)/6) h. The method is symmetric, so its global error has only even
+  // powers of h and one Richardson step (16 Phi_{h/2} - Phi_h) / 15 makes it sixth order.
+  auto run = [&](int S) {
+    const double h = T0 / S, g = std::sqrt(3.0) / 6.0;
+    Eigen::VectorXd t(2 * S);
+    for (int k = 0; k < S; ++k) {
+      t[2 * k] = (k + 0.5 - g) * h;
+      t[2 * k + 1] = (k + 0.5 + g) * h;
+    }
+    const Eigen::MatrixXd a = m.a_at(t);
+    Eigen::MatrixXd F1 = Eigen::MatrixXd::Zero(na, na), F2 = F1;
+    for (int r = 0; r + 1 < na; ++r) F1(r, r + 1) = F2(r, r + 1) = 1.0;
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(na, na);
+    for (int k = 0; k < S; ++k) {
+      for (int n = 0; n < na; ++n) {
+        F1(na - 1, n) = -a(2 * k, n) / a(2 * k, na);
+        F2(na - 1, n) = -a(2 * k + 1, n) / a(2 * k + 1, na);
+      }
+      const Eigen::MatrixXd Omega = 0.5 * h * (F1 + F2) + (std::sqrt(3.0) / 12.0) * h * h * (F2 * F1 - F1 * F2);
+      Phi = Eigen::MatrixXd(Omega.exp()) * Phi;
+    }
+    return Phi;
+  };
+  const Eigen::MatrixXd coarse = run(steps), fine = run(2 * steps);
+  Eigen::MatrixXd Phi = fine + (fine - coarse) / 15.0;
+  if (!Phi.allFinite()) throw NumericalError("the product of matrix exponentials overflowed");
+  return Phi;
+}
+
+}  // namespace lptv

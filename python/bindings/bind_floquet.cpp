@@ -1,0 +1,27 @@
+#include "lptv/floquet.hpp"
+#include "pybind11.hpp"
+
+void bind_floquet(py::module_& m) {
+  py::class_<lptv::Floquet>(m, "Floquet", "Characteristic multipliers and Floquet exponents (lptv::floquet).")
+      .def_readonly("multipliers", &lptv::Floquet::multipliers)
+      .def_readonly("exponents", &lptv::Floquet::exponents)
+      .def_readonly("error_estimate", &lptv::Floquet::error_estimate)
+      .def_readonly("spectral_radius", &lptv::Floquet::spectral_radius)
+      .def_readonly("is_stable", &lptv::Floquet::is_stable)
+      .def_readonly("truncation", &lptv::Floquet::truncation)
+      .def_readonly("harmonics", &lptv::Floquet::harmonics)
+      .def_readonly("convergence", &lptv::Floquet::convergence)
+      .def_readonly("method", &lptv::Floquet::method);
+  m.def("floquet", [](const lptv::Model& model, double tol, int min_truncation, int max_truncation) {
+    lptv::FloquetOptions opt;
+    opt.tol = tol;
+    opt.min_truncation = min_truncation;
+    opt.max_truncation = max_truncation;
+    py::gil_scoped_release release;  // the eigenvalue problems are C++ only
+    return lptv::floquet(model, opt);
+  }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
+        "Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).");
+  m.def("monodromy", &lptv::monodromy, "model"_a, "steps"_a, py::call_guard<py::gil_scoped_release>(),
+        "Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps\n"
+        "and Richardson) or of the one-step companion matrices (discrete time).");
+}

@@ -1,0 +1,158 @@
+"""Stability of the periodic system: Floquet multipliers and exponents (METHOD.md section 12)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from . import _core
+from ._validate import as_int, as_positive_float
+from .model import Model
+
+__all__ = ["FloquetResult", "floquet", "monodromy"]
+
+
+@dataclass(frozen=True)
+class FloquetResult:
+    """Result of :func:`floquet`."""
+
+    multipliers: np.ndarray
+    """The na characteristic multipliers mu_i by decreasing magnitude (conjugate pairs with the
+    positive imaginary part first): the eigenvalues of the monodromy matrix. Continuous time:
+    ``exp(exponents * period)``, which underflows to 0 for exponents below about -745 / T0."""
+    exponents: np.ndarray
+    """Floquet exponents lambda_i = ln(mu_i) / T0 in 1/s on the principal branch,
+    ``-w0/2 < Im lambda <= w0/2``; defined modulo j w0 only (lambda + j n w0 gives the same
+    multiplier). Discrete time: the same with T0 = N ts, and -inf for a zero multiplier."""
+    is_stable: bool
+    """Every |mu_i| < 1 by more than its estimated error (asymptotic stability). A multiplier
+    within its error of the unit circle (a marginal system) counts as not stable."""
+    spectral_radius: float
+    """max |mu_i| (0 for na = 0)."""
+    error_estimate: np.ndarray
+    """Estimated relative error of each multiplier (see :func:`floquet`)."""
+    truncation: int
+    """Continuous time: M, the harmonics -M..M of the last Hill matrix; 0 in discrete time."""
+    harmonics: int
+    """Continuous time: harmonics of F(t) kept (those above eps of the largest); 0 in discrete time."""
+    convergence: float
+    """Continuous time: largest change of ln(mu_i) between the last two truncations."""
+    method: str
+    """'hill' (continuous time) or 'product' (discrete time)."""
+    period: float
+    """T0 = 2 pi / w0 in seconds."""
+
+
+def _check_model(model):
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+    return model
+
+
+def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
+            max_truncation: int = 256) -> FloquetResult:
+    """Characteristic multipliers and Floquet exponents of ``model``: is it stable?
+
+    The homogeneous equation ``sum_n a_n(t) d^n y/dt^n = 0`` in the state
+    x = (y, y', ..., y^(na-1)) is x' = F(t) x with F periodic; over one period T0 the state maps
+    as x(T0) = Phi x(0), and the eigenvalues mu_i of the monodromy matrix Phi decide stability:
+    every solution decays iff every |mu_i| < 1. The instantaneous ("frozen") poles of
+    :func:`lptv.frozen_poles` do not decide it: a system whose frozen poles all have negative
+    real parts can be unstable (parametric resonance, see the example).
+
+    Continuous time: Hill's method in the C++ core. The eigenvalues of the truncated harmonic
+    matrix ``[F_{p-q}] - diag(j p w0 I)``, p, q = -M..M, approximate lambda_i + j n w0; one per
+    exponent is kept (the copy whose eigenvector is centred nearest harmonic 0, which the
+    truncation disturbs least), and M grows until the kept exponents change by less than
+    ``tol * (1 + |ln|mu_i||)`` in ln(mu_i), or by less than the rounding error their
+    condition number allows. ``error_estimate`` is the larger of that change and LAPACK's
+    rounding bound. Discrete time (forward shift, state (y[k], ..., y[k+na-1])): the eigenvalues
+    of the product of the N one-step companion matrices; ``error_estimate`` is the rounding of
+    that product amplified by each eigenvalue's condition number, relative to |mu_i|.
+
+    Stability and steady state are separate questions. :func:`lptv.simulate` solves the band
+    system ``A Y = B U``, which has a unique solution whenever no multiplier equals 1 (no
+    exponent on the lines j l w0): for an unstable system it still returns the periodic
+    solution of the equation, which is exact but which the system does not settle into (any
+    deviation from it grows like ``spectral_radius ** (t / T0)``). :func:`lptv.identify` fits
+    the equation to the spectra whatever its stability: given steady-state periodic data (a
+    stabilised experiment, or simulation), it identifies an unstable system as it does a stable
+    one, and does not say so. Check ``lptv.floquet(res.model).is_stable``.
+
+    Parameters
+    ----------
+    model : lptv.Model
+        a_na(t) must not vanish over the period (continuous time: checked on a fine grid;
+        discrete time: at the N samples).
+    tol : float
+        Continuous time: convergence tolerance of the truncation on ln(mu_i).
+    min_truncation, max_truncation : int
+        Continuous time: the first M (raised to the number of harmonics of F(t)) and the largest;
+        beyond it an :class:`lptv.NumericalError` names the M reached.
+
+    Returns
+    -------
+    FloquetResult
+
+    Raises
+    ------
+    ValueError
+        a_na(t) vanishes somewhere over the period (the message gives the time or sample), or an
+        argument is out of range.
+    lptv.NumericalError
+        The exponents did not settle by ``max_truncation``, or 1/a_na(t) needs more harmonics
+        than the core resolves.
+
+    Examples
+    --------
+    The damped Mathieu equation y'' + 2 zeta wn y' + wn^2 (1 + eps cos(w0 t)) y = u with
+    w0 = 2 wn: every frozen pole has real part -zeta wn < 0, yet for eps above about 4 zeta the
+    system is unstable (a multiplier below -1: the solution grows at half the pump frequency).
+
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import mathieu_model
+    >>> m = mathieu_model(zeta=0.02, wn=1.0, eps=0.1, w0=2.0)
+    >>> bool(np.all(lptv.frozen_poles(m, np.linspace(0, m.period, 50)).real < 0))
+    True
+    >>> f = lptv.floquet(m)
+    >>> f.is_stable, np.round(f.multipliers.real, 4)
+    (False, array([-1.0158, -0.8682]))
+    >>> lptv.floquet(mathieu_model(zeta=0.02, wn=1.0, eps=0.06, w0=2.0)).is_stable
+    True
+    """
+    _check_model(model)
+    tol = as_positive_float(tol, "tol")
+    min_truncation = as_int(min_truncation, "min_truncation", minimum=1)
+    max_truncation = as_int(max_truncation, "max_truncation", minimum=1)
+    r = _core.floquet(model._cpp, tol=tol, min_truncation=min_truncation,
+                      max_truncation=max_truncation)
+    return FloquetResult(
+        multipliers=np.asarray(r.multipliers), exponents=np.asarray(r.exponents),
+        is_stable=bool(r.is_stable), spectral_radius=float(r.spectral_radius),
+        error_estimate=np.asarray(r.error_estimate), truncation=int(r.truncation),
+        harmonics=int(r.harmonics), convergence=float(r.convergence), method=r.method,
+        period=model.period if not model.discrete else model.samples_per_period * model.ts)
+
+
+def monodromy(model: Model, steps: Optional[int] = 2000) -> np.ndarray:
+    """The monodromy matrix Phi (na x na) by a route independent of Hill's method, for checks.
+
+    Continuous time: the product of the matrix exponentials of a fourth-order Magnus step over
+    ``steps`` equal sub-intervals of one period (F(t) evaluated from the coefficients at the two
+    Gauss points of each), extrapolated with ``2 * steps`` to sixth order. Discrete time: the
+    product of the N one-step companion matrices (``steps`` is ignored). The multipliers are
+    ``numpy.linalg.eigvals(Phi)``; those far below the largest are only as accurate as
+    eps * ||Phi||.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.floquet import monodromy
+    >>> m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=1.0)           # y' + 2 y: mu = exp(-4 pi)
+    >>> bool(np.isclose(monodromy(m)[0, 0], np.exp(-4 * np.pi), rtol=1e-12))
+    True
+    """
+    _check_model(model)
+    steps = 0 if model.discrete else as_int(steps, "steps", minimum=1)
+    return np.asarray(_core.monodromy(model._cpp, steps))
