@@ -85,6 +85,7 @@ stubs: python
 	rm -rf $(BUILDROOT)/stubs
 	$(VENV)/bin/pybind11-stubgen lptv._core -o $(BUILDROOT)/stubs >/dev/null
 	cp $(BUILDROOT)/stubs/lptv/_core.pyi python/lptv/_core.pyi
+	$(MAKE) --no-print-directory python  # installs the new stubs beside the module
 
 demo: python
 	$(VENV)/bin/lptv demo
