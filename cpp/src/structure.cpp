@@ -248,10 +248,11 @@ std::vector<int> default_rows(const Parametrisation& p, int max_line) {
 }
 
 void check_rows(const Parametrisation& p, const std::vector<int>& rows, int max_line) {
-  const int K = p.structure().kmax();
+  // 64-bit: a row near INT_MAX plus K must not wrap around and pass the check.
+  const long long K = p.structure().kmax();
   if (rows.empty()) throw std::invalid_argument("lines: no rows to fit");
   std::set<int> seen;
-  for (int l : rows) {
+  for (const long long l : rows) {
     if (l < 1) {
       throw std::invalid_argument("lines: row " + std::to_string(l) +
                                   " is not a positive line (rows are lines >= 1)");
@@ -265,10 +266,10 @@ void check_rows(const Parametrisation& p, const std::vector<int>& rows, int max_
       throw std::invalid_argument("lines: row " + std::to_string(l) + " needs line " +
                                   std::to_string(l - K) + " beyond the data");
     }
-    if (!seen.insert(l).second) throw std::invalid_argument("lines: row " + std::to_string(l) + " repeats");
+    if (!seen.insert(static_cast<int>(l)).second) throw std::invalid_argument("lines: row " + std::to_string(l) + " repeats");
   }
-  const int eq = 2 * static_cast<int>(rows.size());
-  const int unknowns = p.n_xi() - 1;
+  const long long eq = 2 * static_cast<long long>(rows.size());
+  const long long unknowns = p.n_xi() - 1;
   if (eq <= unknowns) {
     throw std::invalid_argument(
         "the orders and harmonic counts leave " + std::to_string(unknowns) + " free parameters for " +

@@ -345,3 +345,33 @@ def test_length_one_and_zero_periods_do_not_crash(code):
 def test_band_solver_refused_on_the_discrete_grid():
     check(lambda: lptv.simulate(dt_model(), [1.0, 0.5], solver="band"), ValueError,
           r"^solver: the band solver needs the continuous-time grid")
+
+
+def test_a_row_near_int_max_is_refused_not_read_out_of_bounds():
+    """lines=[2**31 - 1, ...] with K = 1 wrapped around in 32-bit arithmetic and passed the check
+    (then read out of bounds: a segfault). Run in a subprocess so a regression fails this test,
+    not the session."""
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent("""
+        import numpy as np, lptv
+        m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)
+        ms = lptv.multisine(range(1, 60), 256, seed=0)
+        y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
+        u, y = ms.periods(4), np.tile(y1, (4, 1))
+        rng = np.random.default_rng(1)
+        u, y = u + 1e-3 * rng.standard_normal(u.shape), y + 1e-3 * rng.standard_normal(y.shape)
+        for method in ("wgtls", "ls", "sml"):
+            try:
+                lptv.identify(u, y, na=1, nb=0, ka=1, w0=0.1, lines=[2**31 - 1] + list(range(2, 40)),
+                              method=method)
+            except ValueError as e:
+                assert "2147483647" in str(e) and "lines" in str(e), e
+            else:
+                raise AssertionError("accepted")
+        print("ok")
+    """)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and p.stdout.strip() == "ok", (p.returncode, p.stderr[-2000:])
