@@ -58,22 +58,47 @@ class SingleThreadedBlas {
  public:
   explicit SingleThreadedBlas(bool active) {
     if (!active) return;
-    set_ = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
-    auto get = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
-    if (!set_ || !get) {
-      set_ = nullptr;
-      return;
-    }
-    saved_ = get();
-    set_(1);
+    const OpenBlas& ob = openblas();
+    if (!ob.set || !ob.get) return;
+    set_ = ob.set;
+    saved_ = ob.get();
+    if (saved_ != 1) set_(1);
   }
   ~SingleThreadedBlas() {
-    if (set_) set_(saved_);
+    if (set_ && saved_ != 1) set_(saved_);
   }
   SingleThreadedBlas(const SingleThreadedBlas&) = delete;
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
 
  private:
+  struct OpenBlas {
+    void (*set)(int) = nullptr;
+    int (*get)() = nullptr;
+  };
+  // OpenBLAS's thread controls, found once. In a program linked against it they are global
+  // symbols; in a Python extension module the library is loaded with RTLD_LOCAL and
+  // dlsym(RTLD_DEFAULT) does not see them, so the already loaded library is also looked up by
+  // name (RTLD_NOLOAD: never loads anything new).
+  static const OpenBlas& openblas() {
+    static const OpenBlas ob = [] {
+      OpenBlas o;
+      auto find = [&](void* h) {
+        o.set = reinterpret_cast<void (*)(int)>(dlsym(h, "openblas_set_num_threads"));
+        o.get = reinterpret_cast<int (*)()>(dlsym(h, "openblas_get_num_threads"));
+        return o.set && o.get;
+      };
+      if (find(RTLD_DEFAULT)) return o;
+      for (const char* name : {"libopenblas.so.0", "libopenblas.so", "libblas.so.3"}) {
+        if (void* h = dlopen(name, RTLD_LAZY | RTLD_NOLOAD)) {
+          if (find(h)) return o;  // the handle stays open: the library is in use anyway
+          dlclose(h);
+        }
+      }
+      o = OpenBlas();
+      return o;
+    }();
+    return ob;
+  }
   void (*set_)(int) = nullptr;
   int saved_ = 1;
 };

@@ -94,9 +94,13 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
     """
     if not isinstance(model, Model):
         raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
-    U = u.spectrum if isinstance(u, Multisine) else as_spectrum(u, "u")
-    if U.ndim != 1:
-        raise ValueError(f"u must be one spectrum (1-D), got shape {U.shape}")
+    if isinstance(u, Multisine):
+        U = u.spectrum
+    else:
+        U2, was_1d = as_spectrum(u, "u")
+        if not was_1d:
+            raise ValueError(f"u must be one spectrum (1-D), got shape {U2.shape}")
+        U = U2[:, 0]
     periods = as_int(periods, "periods", minimum=1)
     n = U.size
     vy, vu = _per_line(var_y, n, "var_y"), _per_line(var_u, n, "var_u")

@@ -118,3 +118,19 @@ def test_public_crb_of_an_lti_design_matches_the_closed_form():
     C = np.linalg.inv(F)
     assert b.std[[0, 2]] == pytest.approx(np.sqrt(np.diag(C)), rel=1e-10)
     assert b.std[1] == 0.0
+
+
+def test_public_crb_takes_a_spectrum_or_a_multisine_and_checks_its_arguments():
+    m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)
+    ms = lptv.multisine(range(1, 60), 256, seed=0)
+    a = lptv.crb(m, ms, var_y=1e-5, var_u=1e-6, periods=4)
+    b = lptv.crb(m, ms.spectrum, var_y=1e-5, var_u=1e-6, periods=4)
+    assert np.array_equal(a.covariance, b.covariance)
+    with pytest.raises(ValueError, match="u must be one spectrum"):
+        lptv.crb(m, np.c_[ms.spectrum, ms.spectrum], var_y=1e-5)
+    with pytest.raises(ValueError, match="var_y"):
+        lptv.crb(m, ms, var_y=-1.0)
+    with pytest.raises(ValueError, match="cov_yu"):
+        lptv.crb(m, ms, var_y=1e-6, var_u=1e-6, cov_yu=1e-5)
+    with pytest.raises(ValueError, match="periods"):
+        lptv.crb(m, ms, var_y=1e-6, periods=0)
