@@ -9,6 +9,8 @@ The public API:
   SML on the exact likelihood) with the covariance of the estimate;
 - :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
+- :func:`montecarlo`, :func:`identify_many` - Monte Carlo studies and many records at once, on
+  local processes or a Dask cluster (:mod:`lptv.batch`);
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
 - :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
 """
@@ -21,11 +23,12 @@ from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import Multisine, multisine, spectrum, time_signal
+from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 
 __version__ = "0.1.0"
 
 __all__ = [
     "CramerRaoBound", "FrequencyData", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
-    "band_matrices", "crb", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
-    "identify", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
+    "BatchResult", "MonteCarloResult", "band_matrices", "crb", "expected_fraction_above_0db", "frozen_poles", "frozen_zeros", "htf",
+    "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
 ]
