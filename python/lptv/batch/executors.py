@@ -83,7 +83,7 @@ def one_blas_thread():
     return threadpool_limits(limits=1, user_api="blas").restore_original_limits
 
 
-def run_chunk(fn: Callable, items: Sequence, shared: Any) -> list:
+def run_chunk(items: Sequence, fn: Callable, shared: Any) -> list:
     """The task a worker runs: ``fn(item, shared)`` for each item, failures caught per item.
 
     The worker keeps one BLAS thread afterwards (restoring would race with other tasks of a
@@ -267,7 +267,7 @@ def _run_futures(fn, items, shared, executor, workers, chunk_size, bar, weight):
         return out
     pool = cf.ProcessPoolExecutor(max_workers=min(workers, len(chunks))) if own else executor
     try:
-        futures = {pool.submit(run_chunk, fn, [items[i] for i in c], shared): c for c in chunks}
+        futures = {pool.submit(run_chunk, [items[i] for i in c], fn, shared): c for c in chunks}
         for fut in cf.as_completed(futures):
             c = futures[fut]
             try:
@@ -296,8 +296,9 @@ def _run_dask(fn, items, shared, executor, chunk_size, bar, weight):
             return out
         # one copy of the design per worker instead of one per task
         shared_f = client.scatter(shared, broadcast=True, hash=False)
-        futures = [client.submit(run_chunk, fn, [items[i] for i in c], shared_f, pure=False)
-                   for c in chunks]
+        # one message for all tasks (client.map), not one per task
+        futures = client.map(run_chunk, [[items[i] for i in c] for c in chunks], fn=fn, shared=shared_f,
+                             pure=False)
         where = {f.key: c for f, c in zip(futures, chunks)}
         try:
             for fut in distributed.as_completed(futures, loop=client.loop):
