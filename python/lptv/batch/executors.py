@@ -133,7 +133,11 @@ class _Progress:
             if progress is True:
                 raise ImportError(f"progress=True needs the package 'tqdm': {EXTRA}") from None
             return
-        self.bar = tqdm(total=total, desc=desc, unit=unit, smoothing=0.1, dynamic_ncols=True)
+
+        class Bar(tqdm):
+            monitor_interval = 0   # no monitor thread: the process pool may fork after this
+
+        self.bar = Bar(total=total, desc=desc, unit=unit, smoothing=0.1, dynamic_ncols=True)
 
     def update(self, n):
         if self.bar is not None:
