@@ -103,7 +103,7 @@ def realisation(item, design) -> list:
     return [_fit(data, m, design["fit"]) for m in design["methods"]]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MonteCarloResult(MonteCarloTables):
     """What :func:`montecarlo` returns: every estimate, its reported std, and the bound.
 

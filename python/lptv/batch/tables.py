@@ -94,7 +94,7 @@ class MonteCarloTables:
     def overview(self):
         """One row per method: runs, failures, not_converged, residue_rejected (fraction of the
         fits whose normalised-residue test fails), coverage pooled over the parameters and its
-        standard error, variance / CRB median and max (relative sampling error of one ratio
+        binomial standard error (as if the parameters were independent), variance / CRB median and max (relative sampling error of one ratio
         ``var_over_crb_se``), largest |bias| in standard errors."""
         pd = require("pandas", "MonteCarloResult.overview")
         rows = []
