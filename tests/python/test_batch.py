@@ -173,6 +173,20 @@ def _forty_over(x, shared):
     return shared / x
 
 
+def _scaled(x, shared):
+    return x * shared["scale"]
+
+
+def test_consecutive_runs_on_one_dask_client_do_not_share_the_scattered_design(dask_cluster):
+    """Each run scatters its shared argument under a key of its own: a dict scattered as it is
+    would take its own keys, and the release of one run's copy would cancel the next run's tasks."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.Client(dask_cluster) as client:
+        for k in range(4):
+            out = run_tasks(_scaled, range(6), {"scale": k}, executor=client, chunk_size=2, progress=False)
+            assert out == [k * i for i in range(6)]
+
+
 # ------------------------------------------------------------------------------ statistics
 
 def test_lti_study_agrees_with_the_closed_form_crb(batch_tol):

@@ -298,8 +298,9 @@ def _run_dask(fn, items, shared, executor, chunk_size, bar, weight):
         out = [None] * len(items)
         if not chunks:
             return out
-        # one copy of the design per worker instead of one per task
-        shared_f = client.scatter(shared, broadcast=True, hash=False)
+        # one copy of the design per worker instead of one per task; in a list, so that it gets a
+        # key of its own (a dict would be scattered under its own keys, shared by every run)
+        [shared_f] = client.scatter([shared], broadcast=True, hash=False)
         # one message for all tasks (client.map), not one per task
         futures = client.map(run_chunk, [[items[i] for i in c] for c in chunks], fn=fn, shared=shared_f,
                              pure=False)
