@@ -74,7 +74,7 @@ def main():
     t_cluster = time.perf_counter() - t0
     study(client, 4)
     print(f"Dask LocalCluster (2 workers x 1 thread) started in {t_cluster:.2f} s, warmed by a 4-run study")
-    trim = {c: next(iter(cl.run(os.environ.get, "MALLOC_TRIM_THRESHOLD_").values()))
+    trim = {c: next(iter(cl.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values()))
             for c, cl in (("default", client), ("unset", client_nt))}
     print(f"MALLOC_TRIM_THRESHOLD_ in the workers: {trim}")
 
