@@ -15,25 +15,13 @@ import warnings
 import numpy as np
 
 import lptv
-from lptv.examples import (PAPER_ID_LINES, PAPER_NOISE, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB, noisy_periods,
-                           paper_model, paper_multisine)
+from lptv.examples import (PAPER_ID_LINES, PAPER_NOISE, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB, noise_variances,
+                           noisy_periods, paper_model, paper_multisine)
 
 
 def true_noise(ms, y0):
     """Per-line (co)variances of one period's noise spectra, lines 0..N/2."""
-    N = ms.signal.size
-    w = 2 * np.pi * np.arange(N // 2 + 1) / N
-
-    def shape(a):
-        return (1 - a ** 2) / np.abs(1 - a * np.exp(-1j * w)) ** 2
-
-    su = np.sqrt(np.mean(ms.signal ** 2)) * 10 ** (-PAPER_SNR_IN_DB / 20)
-    sy = np.sqrt(np.mean(y0 ** 2)) * 10 ** (-PAPER_SNR_OUT_DB / 20)
-    rho, Si, So = PAPER_NOISE["correlation"], shape(PAPER_NOISE["pole_in"]), shape(PAPER_NOISE["pole_out"])
-    var_u = su ** 2 * Si / N
-    var_y = sy ** 2 * (rho ** 2 * Si + (1 - rho ** 2) * So) / N
-    cov_yu = su * sy * rho * Si / N
-    return var_u, var_y, cov_yu
+    return noise_variances(ms.signal, y0, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB, **PAPER_NOISE)
 
 
 def study(P, R, model, ms, y0, crb, seeds):

@@ -11,6 +11,8 @@ The public API:
 - :func:`htf_estimate` - the harmonic transfer function's branches from data, without a model;
 - :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
+- :func:`montecarlo`, :func:`identify_many` - Monte Carlo studies and many records at once, on
+  local processes or a Dask cluster (:mod:`lptv.batch`);
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
 - :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
 """
@@ -25,11 +27,14 @@ from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import Multisine, multisine, spectrum, time_signal
+from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "CramerRaoBound", "FloquetResult", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS", "IdentificationResult", "Model", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
+    "BatchResult", "CramerRaoBound", "FloquetResult", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS",
+    "IdentificationResult", "Model", "MonteCarloResult", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
     "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
-    "identify", "normalized_residue", "read_measurements", "Measurements", "multisine", "simulate", "spectrum", "time_signal",
+    "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",
+    "simulate", "spectrum", "time_signal",
 ]

@@ -16,7 +16,8 @@ amplitudes, w0 or number of periods; the choices below are ours, stated here:
   lines) and N = 2048 samples per period;
 - the measurement noise (``paper_measurements``): 50 dB mean SNR on the input, 30 dB on the
   output, first-order low-pass noise with poles 0.6 (input) and 0.8 (output), the output noise
-  sharing half of its driving sequence with the input noise (``PAPER_NOISE``).
+  sharing half of its driving sequence with the input noise (``PAPER_NOISE``);
+  ``noise_variances`` gives the true per-line (co)variances of that noise, for :func:`lptv.crb`.
 """
 from __future__ import annotations
 
@@ -147,6 +148,60 @@ def noisy_periods(u0, y0, periods: int, snr_in_db: float, snr_out_db: float, see
     u = np.tile(u0, (P, 1)) + su * cu.reshape(P, N)
     y = np.tile(y0, (P, 1)) + sy * cy.reshape(P, N)
     return u, y
+
+
+def noise_variances(u0, y0, snr_in_db: float, snr_out_db: float, pole_in: float = 0.0,
+                    pole_out: float = 0.0, correlation: float = 0.0):
+    """True per-line (co)variances of ONE period's noise spectra for :func:`noisy_periods`.
+
+    First-order low-pass noise 1 / (1 - a z^-1) scaled to unit variance has the power spectrum
+    (1 - a^2) / |1 - a e^{-jw}|^2; one period's DFT ``X_l = fft(x)[l] / N`` of noise with
+    standard deviation ``s`` then has the variance ``s**2 S(w_l) / N``. The output noise is
+    ``correlation`` times the input noise's colour plus the rest of its own, so
+    ``E{dY conj(dU)} = s_u s_y correlation S_in(w_l) / N``. These are what :func:`lptv.crb`
+    takes (``var_u``, ``var_y``, ``cov_yu``) to give the bound of a design with this noise.
+
+    Parameters
+    ----------
+    u0, y0 : array_like, shape (N,)
+        One noise-free period of the input and the output (the SNRs refer to their rms).
+    snr_in_db, snr_out_db, pole_in, pole_out, correlation :
+        As for :func:`noisy_periods` (``inf`` dB: no noise on that side).
+
+    Returns
+    -------
+    var_u, var_y : ndarrays (N//2 + 1,)
+    cov_yu : ndarray (N//2 + 1,)
+        Lines 0 .. N//2.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lptv.examples import noise_variances
+    >>> u0 = np.sqrt(2) * np.cos(2 * np.pi * 5 * np.arange(64) / 64)      # rms 1
+    >>> var_u, var_y, cov_yu = noise_variances(u0, u0, 20.0, np.inf)        # white, s = 0.1
+    >>> bool(np.allclose(var_u, 0.01 / 64)), float(var_y.max()), float(abs(cov_yu).max())
+    (True, 0.0, 0.0)
+    """
+    u0 = np.asarray(u0, float)
+    y0 = np.asarray(y0, float)
+    if u0.shape != y0.shape or u0.ndim != 1:
+        raise ValueError("u0 and y0 must be 1-D periods of the same length")
+    if not -1.0 <= correlation <= 1.0:
+        raise ValueError(f"correlation must lie in [-1, 1], got {correlation}")
+    N = u0.size
+    w = 2 * np.pi * np.arange(N // 2 + 1) / N
+
+    def shape(a):
+        return (1 - a ** 2) / np.abs(1 - a * np.exp(-1j * w)) ** 2
+
+    su = np.sqrt(np.mean(u0 ** 2)) * 10 ** (-snr_in_db / 20)
+    sy = np.sqrt(np.mean(y0 ** 2)) * 10 ** (-snr_out_db / 20)
+    s_in, s_out = shape(pole_in), shape(pole_out)
+    var_u = su ** 2 * s_in / N
+    var_y = sy ** 2 * (correlation ** 2 * s_in + (1 - correlation ** 2) * s_out) / N
+    cov_yu = (su * sy * correlation * s_in / N).astype(complex)
+    return var_u, var_y, cov_yu
 
 
 def paper_measurements(seed=2024, periods: int = 8) -> dict:

@@ -280,3 +280,36 @@ def floquet_tol():
         EPS=EPS, VS_PRODUCT=FLOQUET_VS_PRODUCT, PRODUCT_STEP=FLOQUET_PRODUCT_STEP,
         KAPPA_MAX=FLOQUET_KAPPA_MAX, VS_CVODE_RTOLS=FLOQUET_VS_CVODE_RTOLS,
         CVODE_RTOL=FLOQUET_CVODE_RTOL, LTI=FLOQUET_LTI, DT_BOUND_FACTOR=FLOQUET_DT_BOUND_FACTOR)
+
+
+# ==================================================================================================
+# Batch runs and Monte Carlo studies: tests/python/test_batch.py and test_cli_batch.py.
+# ==================================================================================================
+
+# A study's statistics against the closed-form bound, within BATCH_MC_SIGMAS of their sampling
+# error: the relative std of a sample variance of R normal draws is sqrt(2 / (R - 1)), that of a
+# coverage sqrt(level (1 - level) / R), that of a mean the sample std / sqrt(R). Four sigmas over
+# the ~10 numbers compared give a false alarm ~6e-4 (the draws are seeded: a run is reproducible).
+BATCH_MC_SIGMAS = 4.0
+# Per-line noise (co)variances against the mean periodogram of D draws: each |X_l|^2 is
+# exponential (chi^2 with 1 dof at DC and Nyquist: sqrt(2) times the spread), so the mean has a
+# relative std of sqrt(2 / D) at most; 5 sigmas over ~100 lines.
+BATCH_NOISE_SIGMAS = 5.0
+
+
+@pytest.fixture(scope="session")
+def batch_tol():
+    return SimpleNamespace(MC_SIGMAS=BATCH_MC_SIGMAS, NOISE_SIGMAS=BATCH_NOISE_SIGMAS)
+
+
+@pytest.fixture(scope="session")
+def dask_cluster():
+    """A Dask LocalCluster of 2 worker processes with 1 thread each, started by the first test that
+    asks for it and torn down at the end of the session (the workers inherit PYTHONPATH)."""
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, host="127.0.0.1")
+    try:
+        yield cluster
+    finally:
+        cluster.close()

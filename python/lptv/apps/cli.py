@@ -3,6 +3,9 @@
     lptv demo [--out DIR] [--monte-carlo R] [--quick]     the paper's simulation example
     lptv demo lecture [--out DIR] [--quick]               the lecture's cases
     lptv identify FILE --na 2 --nb 1 ...                  a model from your own measurements
+    lptv identify FILES... [--workers N | --scheduler ADDRESS]   many files, one row each
+    lptv montecarlo --runs R --periods P --method wgtls,sml [--scheduler ADDRESS]
+                                                          a Monte Carlo study of the estimators
 """
 from __future__ import annotations
 
@@ -33,6 +36,9 @@ def main(argv=None) -> int:
     from lptv.apps import fileid
 
     fileid.add_parser(sub)
+    from lptv.apps import montecarlo
+
+    montecarlo.add_parser(sub)
     args = parser.parse_args(argv)
     if args.command == "demo":
         if args.monte_carlo < 0:
@@ -48,6 +54,8 @@ def main(argv=None) -> int:
         return demo.run(args)
     if args.command == "identify":
         return fileid.run(args)
+    if args.command == "montecarlo":
+        return montecarlo.run(args)
     parser.error(f"unknown command {args.command}")
     return 2
 

@@ -1,5 +1,8 @@
 """``lptv identify FILE``: an LPTV model from your own periodic measurements.
 
+(Several files, ``lptv identify FILES... [--workers N | --scheduler ADDRESS]``, are fitted as a
+batch by :mod:`lptv.apps.manyid`.)
+
 The file holds P >= 2 steady-state periods of the input u and the output y:
 
 - CSV: a header row naming the columns ``u`` and ``y`` (other columns are ignored), one sample
@@ -56,7 +59,7 @@ def parse_lines(text: str) -> np.ndarray:
     return np.array(out)
 
 
-def _counts(text, opt):
+def parse_counts(text, opt):
     try:
         ks = [int(t) for t in text.split(",")]
     except ValueError:
@@ -67,7 +70,7 @@ def _counts(text, opt):
     return ks[0] if len(ks) == 1 else ks
 
 
-def _known(text):
+def parse_known(text):
     if text is None:
         return None
     out = {}
@@ -86,7 +89,7 @@ def _known(text):
     return out
 
 
-def _positive(value, opt):
+def positive(value, opt):
     if value is not None and not (np.isfinite(value) and value > 0):
         raise FileError(f"{opt} must be a positive number, got {value:g}")
     return value
@@ -94,15 +97,15 @@ def _positive(value, opt):
 
 def _fundamental(args, meas):
     """w0 from --w0 / --period, the file, and (discrete time) --ts with the samples per period."""
-    w0 = _positive(args.w0, "--w0")
-    if _positive(args.period, "--period") is not None:
+    w0 = positive(args.w0, "--w0")
+    if positive(args.period, "--period") is not None:
         w0 = 2 * np.pi / args.period
     given = "--w0" if args.w0 is not None else "--period"
     if meas.w0 is not None:
         if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
             raise FileError(f"{given} gives w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
         w0, given = meas.w0, "the file's w0"
-    if _positive(args.ts, "--ts") is not None:
+    if positive(args.ts, "--ts") is not None:
         n = meas.u.shape[1]
         w0_ts = 2 * np.pi / (n * args.ts)
         if w0 is None:
@@ -121,15 +124,19 @@ Identify an LPTV model from P >= 2 measured steady-state periods of input u and 
   .csv  header row naming columns u and y, periods one after another (needs --periods)
   .npz  arrays u, y of shape (P, N); optional scalar w0 (rad/s)
   .mat  MATLAB v5 or v7.3: variables u, y of size P x N; optional scalar w0
-Writes model.json, report.html and summary.json, and prints the validation verdict."""
+Writes model.json, report.html and summary.json, and prints the validation verdict.
+Several files (or --workers / --scheduler) make a batch: one row per file in results.csv,
+each model in models/, the fits on local processes or a Dask cluster."""
 
 
 def add_parser(sub):
     p = sub.add_parser(
         "identify", help="identify an LPTV model from a measurement file (CSV, NPZ, MAT)",
         description=_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog="example: lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243")
-    p.add_argument("file", help="measurements: .csv, .npz or .mat")
+        epilog="examples: lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
+               "          lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2")
+    p.add_argument("files", nargs="+", metavar="FILE",
+                   help="measurements: .csv, .npz or .mat; several files are fitted as a batch")
     p.add_argument("--na", type=int, required=True, help="order of the output side")
     p.add_argument("--nb", type=int, required=True, help="order of the input side")
     p.add_argument("--ka", default="0", help="harmonics of every a_n, or a comma list one per a_n (default 0)")
@@ -145,6 +152,11 @@ def add_parser(sub):
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
     p.add_argument("--tol", type=float, default=1e-10, help="WGTLS relative tolerance (default 1e-10)")
+    b = p.add_mutually_exclusive_group()
+    b.add_argument("--workers", type=int, metavar="N",
+                   help="batch: fit the files on N local processes (default: all cores; 1: serially)")
+    b.add_argument("--scheduler", metavar="ADDRESS",
+                   help="batch: fit the files on a Dask cluster, e.g. tcp://10.0.0.5:8786")
     return p
 
 
@@ -161,13 +173,17 @@ def _fail(name, problem) -> int:
 # ------------------------------------------------------------------------------ running
 
 def run(args) -> int:
-    src = args.file
+    if len(args.files) > 1 or args.workers is not None or args.scheduler is not None:
+        from lptv.apps import manyid
+
+        return manyid.run(args)
+    src = args.files[0]
     try:
         lines = parse_lines(args.lines) if args.lines is not None else None
-        ka, kb, known = _counts(args.ka, "--ka"), _counts(args.kb, "--kb"), _known(args.known)
+        ka, kb, known = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb"), parse_known(args.known)
         if args.max_iter < 0:
             raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
-        _positive(args.tol, "--tol")
+        positive(args.tol, "--tol")
         meas = read_measurements(src, args.periods)
         w0 = _fundamental(args, meas)
         with warnings.catch_warnings(record=True) as caught:
@@ -213,7 +229,7 @@ def _prediction_gap_db(res, Y_pred):
 def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
     P, N = meas.u.shape
     return {
-        "file": str(args.file), "format": meas.format, "periods": P, "samples_per_period": N,
+        "file": str(args.files[0]), "format": meas.format, "periods": P, "samples_per_period": N,
         "w0": w0, "ts": args.ts, "na": res.model.na, "nb": res.model.nb,
         "ka": ka, "kb": kb, "method": res.method,
         "n_lines": int(res.lines.size), "first_line": int(res.lines.min()),

@@ -1,0 +1,102 @@
+"""``lptv identify FILES... [--workers N | --scheduler ADDRESS]``: many records, one row each.
+
+The options are those of ``lptv identify FILE`` (:mod:`lptv.apps.fileid`), the same for every
+file. The fits run on local processes (``--workers``, default all cores; 1 runs them here) or on
+a Dask cluster (``--scheduler``: the files are read by the workers, so their paths must exist
+there). Writes ``results.csv`` (one row per file: the verdict, the parameters and their std,
+or the error message), ``models/<file stem>.json`` for each file that was fitted and
+``summary.json``; prints one line per file. Exit status 0 when every file was fitted, 1 when
+some failed (their rows say why), 2 for bad options.
+
+Example::
+
+    lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243 --workers 2 --out fleet
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from lptv import identify_many
+from lptv.apps.fileid import parse_counts, parse_known, parse_lines, positive
+from lptv.apps.report import write_json
+from lptv.measurements import FileError
+
+
+def _error(problem) -> int:
+    print(f"lptv identify: error: {' '.join(str(problem).split())}", file=sys.stderr)
+    return 2
+
+
+def executor_of(args):
+    """(executor, workers) from --workers / --scheduler."""
+    if args.scheduler is not None:
+        return args.scheduler, None
+    if args.workers is not None:
+        if args.workers < 1:
+            raise FileError(f"--workers must be >= 1, got {args.workers}")
+        return ("serial", None) if args.workers == 1 else ("processes", args.workers)
+    return "processes", None
+
+
+def _stems(files):
+    """Unique file names for the models: the stem, with -2, -3 ... when two files share it."""
+    seen, out = {}, []
+    for f in files:
+        stem = Path(f).stem
+        seen[stem] = seen.get(stem, 0) + 1
+        out.append(stem if seen[stem] == 1 else f"{stem}-{seen[stem]}")
+    return out
+
+
+def run(args) -> int:
+    try:
+        lines = parse_lines(args.lines) if args.lines is not None else None
+        ka, kb = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb")
+        known = parse_known(args.known)
+        if args.max_iter < 0:
+            raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
+        positive(args.tol, "--tol")
+        w0 = positive(args.w0, "--w0")
+        if positive(args.period, "--period") is not None:
+            w0 = 2 * np.pi / args.period
+        positive(args.ts, "--ts")
+        if args.periods is not None and args.periods < 1:
+            raise FileError(f"--periods must be a positive integer, got {args.periods}")
+        executor, workers = executor_of(args)
+        result = identify_many(args.files, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts,
+                               lines=lines, method=args.method, known=known, tol=args.tol,
+                               max_iter=args.max_iter, periods=args.periods, executor=executor,
+                               workers=workers)
+    except (FileError, ValueError, ImportError, OSError) as e:
+        return _error(e)
+
+    out = Path(args.out) if args.out else Path("lptv-identify")
+    print(f"lptv identify: {len(args.files)} files, {args.method}, {result.executor}, "
+          f"{result.elapsed:.1f} s -> {out}/")
+    for row in result.rows:
+        if row["ok"]:
+            verdict = "residue consistent with the noise" if row["residue_ok"] else "residue OUTSIDE the band"
+            conv = "" if row["converged"] else ", NOT converged"
+            print(f"  ok      {row['record']}: {row['periods']} x {row['samples']}, {verdict}{conv}")
+        else:
+            print(f"  FAILED  {row['record']}: {row['error']}")
+    try:
+        (out / "models").mkdir(parents=True, exist_ok=True)
+        result.save(out / "results.csv")
+        for stem, model in zip(_stems(args.files), result.models):
+            if model is not None:
+                model.save(out / "models" / f"{stem}.json")
+        write_json(out / "summary.json", {
+            "files": len(result.rows), "fitted": len(result.rows) - result.n_failed,
+            "failed": result.n_failed, "not_converged": sum(1 for r in result.rows if r["ok"] and not r["converged"]),
+            "residue_outside_band": sum(1 for r in result.rows if r["ok"] and not r["residue_ok"]),
+            "method": args.method, "executor": result.executor, "seconds": result.elapsed,
+            "failures": [{"file": f, "error": e} for f, e in result.failures]})
+    except OSError as e:
+        return _error(f"{e.filename or out}: {e.strerror or e}")
+    print(f"{len(result.rows) - result.n_failed} of {len(result.rows)} files fitted; wrote "
+          f"{out / 'results.csv'}, {out / 'models'}/, {out / 'summary.json'}")
+    return 1 if result.n_failed else 0

@@ -1,0 +1,324 @@
+"""Running many small tasks: serially, on local processes or on a Dask cluster.
+
+A fit takes about 10 ms, so the work is many small tasks and the per-task overhead of the
+executor decides the speed: :func:`run_tasks` sends the items in chunks (one task per chunk),
+puts the results back in the order of the items whatever order the chunks finish in, and shows
+a progress bar with an ETA on the terminal. An item whose function raises becomes a
+:class:`Failure` holding the message, and so does every item of a chunk that was lost (a worker
+that died): the other items still finish.
+
+Executors (the ``executor`` argument):
+
+- ``"processes"`` (the default): a :class:`concurrent.futures.ProcessPoolExecutor` with
+  ``workers`` processes (default: the cores this process may use), shut down at the end;
+- ``"serial"``: in this process, one item after the other;
+- a scheduler address such as ``"tcp://10.0.0.5:8786"``: a :class:`distributed.Client`
+  connected for the run and closed at the end (``pip install 'lptv[batch]'``);
+- a :class:`distributed.Client` (or a :class:`concurrent.futures.Executor`) of your own: used
+  as it is and left open, so that several runs share one cluster or one pool.
+
+Results do not depend on the executor: the tasks draw their random numbers from seeds handed
+to them (see :func:`lptv.montecarlo`), never from the worker they run on, and they run with
+one BLAS thread wherever they run. The thread count of OpenBLAS changes the rounding of its
+reductions (the core's solves differ in the last bits between 1 and 2 threads), and Dask
+workers start with OPENBLAS_NUM_THREADS=1 while a local process has one thread per core;
+threadpoolctl (in the extra) sets it to 1 in every worker, and in this process for a serial
+run. One thread per process is also what a process per core wants.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import math
+import os
+import sys
+import traceback
+from dataclasses import dataclass
+from typing import Any, Callable, List, Optional, Sequence
+
+EXTRA = "pip install 'lptv[batch]'"
+# Largest chunk: 32 fits of ~12 ms are ~0.4 s, against ~1-3 ms of per-task overhead on Dask
+# (bench/RESULTS.md), while leaving several chunks per worker for balance and for the ETA.
+MAX_CHUNK = 32
+CHUNKS_PER_WORKER = 4
+
+
+@dataclass(frozen=True)
+class Failure:
+    """What :func:`run_tasks` gives for an item whose task raised: the error, on one line."""
+
+    message: str
+    detail: str = ""
+    """The traceback (or the reason the chunk was lost)."""
+
+
+def require(module: str, what: str):
+    """Import an optional dependency, or raise ImportError naming the extra that brings it."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise ImportError(f"{what} needs the package '{module.split('.')[0]}': {EXTRA}") from None
+
+
+def _one_line(e: BaseException) -> str:
+    text = " ".join(str(e).split())
+    return f"{type(e).__name__}: {text}" if text else type(e).__name__
+
+
+def _call(fn, item, shared):
+    try:
+        return fn(item, shared)
+    except Exception as e:  # noqa: BLE001 - reported in the item's row, the batch goes on
+        return Failure(_one_line(e), traceback.format_exc())
+
+
+def one_blas_thread():
+    """Limit the BLAS libraries loaded in this process to one thread; returns the function that
+    restores the previous limits (a no-op without threadpoolctl)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        return lambda: None
+    return threadpool_limits(limits=1, user_api="blas").restore_original_limits
+
+
+def run_chunk(items: Sequence, fn: Callable, shared: Any) -> list:
+    """The task a worker runs: ``fn(item, shared)`` for each item, failures caught per item.
+
+    The worker keeps one BLAS thread afterwards (restoring would race with other tasks of a
+    multi-threaded Dask worker; a worker of a batch has no other use for BLAS threads).
+    """
+    one_blas_thread()
+    return [_call(fn, item, shared) for item in items]
+
+
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def default_chunk_size(n_items: int, workers: int) -> int:
+    """Items per task: about CHUNKS_PER_WORKER tasks per worker, at most MAX_CHUNK items each.
+
+    >>> default_chunk_size(2000, 2), default_chunk_size(2000, 100), default_chunk_size(3, 2)
+    (32, 5, 1)
+    """
+    return max(1, min(MAX_CHUNK, math.ceil(n_items / (CHUNKS_PER_WORKER * max(1, workers)))))
+
+
+def _is_dask_client(obj) -> bool:
+    return type(obj).__module__.split(".")[0] == "distributed" and hasattr(obj, "scheduler_info")
+
+
+def _looks_like_address(text: str) -> bool:
+    return "://" in text or (":" in text and text.rsplit(":", 1)[1].isdigit())
+
+
+class _Progress:
+    """A tqdm bar on a terminal (``progress=None``), always (True) or never (False)."""
+
+    def __init__(self, total, progress, desc, unit):
+        self.bar = None
+        if progress is None:
+            progress = sys.stderr.isatty()
+        if not progress:
+            return
+        try:
+            from tqdm.auto import tqdm
+        except ImportError:
+            if progress is True:
+                raise ImportError(f"progress=True needs the package 'tqdm': {EXTRA}") from None
+            return
+
+        class Bar(tqdm):
+            monitor_interval = 0   # no monitor thread: the process pool may fork after this
+
+        self.bar = Bar(total=total, desc=desc, unit=unit, smoothing=0.1, dynamic_ncols=True)
+
+    def update(self, n):
+        if self.bar is not None:
+            self.bar.update(n)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def describe_executor(executor, workers=None) -> str:
+    """A short description, e.g. '2 processes' or 'dask tcp://127.0.0.1:8786 (4 threads)'."""
+    if executor == "serial":
+        return "serial"
+    if executor == "processes":
+        return f"{workers or available_cores()} processes"
+    if isinstance(executor, str):
+        return f"dask {executor}"
+    if _is_dask_client(executor):
+        return f"dask {executor.scheduler.address} ({_dask_threads(executor)} threads)"
+    return type(executor).__name__
+
+
+def _dask_threads(client) -> int:
+    info = client.scheduler_info()
+    return max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+
+
+def _check_executor(executor, workers):
+    if workers is not None:
+        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+            raise ValueError(f"workers must be a positive integer, got {workers!r}")
+        if executor != "processes":
+            raise ValueError(f"workers applies to executor='processes' only (executor={executor!r}); "
+                             "a Dask cluster has its own workers")
+    if isinstance(executor, str):
+        if executor in ("serial", "processes") or _looks_like_address(executor):
+            return
+        raise ValueError(f"executor must be 'serial', 'processes', a Dask scheduler address like "
+                         f"'tcp://host:8786', a distributed.Client or a concurrent.futures.Executor; "
+                         f"got {executor!r}")
+    elif not (_is_dask_client(executor) or isinstance(executor, cf.Executor)):
+        raise ValueError(f"executor must be 'serial', 'processes', a scheduler address, a "
+                         f"distributed.Client or a concurrent.futures.Executor, got {type(executor).__name__}")
+
+
+def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="processes",
+              workers: Optional[int] = None, chunk_size: Optional[int] = None, progress=None,
+              desc: str = "lptv", unit: str = "item", weight: int = 1) -> List[Any]:
+    """``[fn(item, shared) for item in items]`` on an executor, in chunks, with progress.
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(item, shared)``; a module-level function (it is pickled by reference, so on a
+        Dask cluster the workers need its module, i.e. lptv, installed).
+    items : sequence
+        Small picklable descriptions of the tasks (an index and a seed, a file name ...).
+    shared : object
+        What every task needs (the design of a study): sent once per chunk (once per worker
+        on Dask, where it is scattered).
+    executor : {'processes', 'serial'}, str, distributed.Client or concurrent.futures.Executor
+        See the module's description.
+    workers : int, optional
+        Processes of ``executor='processes'`` (default: the available cores).
+    chunk_size : int, optional
+        Items per task (default :func:`default_chunk_size`).
+    progress : bool, optional
+        Progress bar with an ETA: None shows it when stderr is a terminal.
+    desc, unit, weight :
+        Label and unit of the bar; each item counts ``weight`` units (e.g. the fits it makes).
+
+    Returns
+    -------
+    list
+        One entry per item, in order: ``fn``'s value or a :class:`Failure`.
+
+    Examples
+    --------
+    >>> from lptv.batch import run_tasks, Failure
+    >>> def inverse(x, shared):
+    ...     return shared / x
+    >>> out = run_tasks(inverse, [1, 2, 0, 4], 8.0, executor="serial", progress=False)
+    >>> out[:2], isinstance(out[2], Failure), out[2].message, out[3]
+    ([8.0, 4.0], True, 'ZeroDivisionError: float division by zero', 2.0)
+    """
+    _check_executor(executor, workers)
+    items = list(items)
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int)
+                                   or chunk_size < 1):
+        raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    bar = _Progress(len(items) * weight, progress, desc, unit)
+    try:
+        if executor == "serial":
+            out = []
+            restore = one_blas_thread()
+            try:
+                for item in items:
+                    out.append(_call(fn, item, shared))
+                    bar.update(weight)
+            finally:
+                restore()
+            return out
+        if executor == "processes" or isinstance(executor, cf.Executor):
+            return _run_futures(fn, items, shared, executor, workers, chunk_size, bar, weight)
+        return _run_dask(fn, items, shared, executor, chunk_size, bar, weight)
+    finally:
+        bar.close()
+
+
+def _chunks(n, size):
+    return [range(i, min(n, i + size)) for i in range(0, n, size)]
+
+
+def _lost(chunk, e, out):
+    f = Failure(f"task lost: {_one_line(e)}", "".join(traceback.format_exception(type(e), e, e.__traceback__)))
+    for i in chunk:
+        out[i] = f
+
+
+def _run_futures(fn, items, shared, executor, workers, chunk_size, bar, weight):
+    own = executor == "processes"
+    if own:
+        workers = workers or available_cores()
+    else:
+        workers = getattr(executor, "_max_workers", None) or available_cores()
+    size = chunk_size or default_chunk_size(len(items), workers)
+    chunks = _chunks(len(items), size)
+    out = [None] * len(items)
+    if not chunks:
+        return out
+    pool = cf.ProcessPoolExecutor(max_workers=min(workers, len(chunks))) if own else executor
+    try:
+        futures = {pool.submit(run_chunk, [items[i] for i in c], fn, shared): c for c in chunks}
+        for fut in cf.as_completed(futures):
+            c = futures[fut]
+            try:
+                for i, r in zip(c, fut.result()):
+                    out[i] = r
+            except Exception as e:  # noqa: BLE001 - a dead worker: its items fail, not the batch
+                _lost(c, e, out)
+            bar.update(weight * len(c))
+    except BaseException:
+        if own:
+            pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    if own:
+        pool.shutdown(wait=True)
+    return out
+
+
+def _run_dask(fn, items, shared, executor, chunk_size, bar, weight):
+    distributed = require("distributed", "a Dask executor")
+    client = distributed.Client(executor, set_as_default=False) if isinstance(executor, str) else executor
+    try:
+        size = chunk_size or default_chunk_size(len(items), _dask_threads(client))
+        chunks = _chunks(len(items), size)
+        out = [None] * len(items)
+        if not chunks:
+            return out
+        # one copy of the design per worker instead of one per task; in a list, so that it gets a
+        # key of its own (a dict would be scattered under its own keys, shared by every run)
+        [shared_f] = client.scatter([shared], broadcast=True, hash=False)
+        # one message for all tasks (client.map), not one per task
+        futures = client.map(run_chunk, [[items[i] for i in c] for c in chunks], fn=fn, shared=shared_f,
+                             pure=False)
+        where = {f.key: c for f, c in zip(futures, chunks)}
+        try:
+            for fut in distributed.as_completed(futures, loop=client.loop):
+                c = where[fut.key]
+                try:
+                    for i, r in zip(c, fut.result()):
+                        out[i] = r
+                except Exception as e:  # noqa: BLE001 - a lost worker or task: its items fail
+                    _lost(c, e, out)
+                bar.update(weight * len(c))
+                fut.release()
+        except BaseException:
+            client.cancel(futures)
+            raise
+        return out
+    finally:
+        if isinstance(executor, str):
+            client.close()
