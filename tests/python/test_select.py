@@ -142,3 +142,40 @@ def test_k_needed_when_the_excitation_is_dense():
     sel = lptv.select(u, y, w0=0.1, na=[1, 2], nb=[0, 1], k=[0], executor="serial")
     assert sel.choice == (1, 0, 0) and sel.htf is None and sel.htf_harmonics is None
     assert any("no HTF guide" in w for w in sel.warnings)
+
+
+def test_docstring_example():
+    import doctest
+    import sys
+
+    module = sys.modules["lptv.selection"]
+    result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
+
+
+def test_cli_select(tmp_path, capsys):
+    import json
+
+    from lptv.apps.cli import main
+
+    m = paper_measurements(seed=1, periods=4)
+    src = tmp_path / "meas.npz"
+    np.savez(src, u=m["u"], y=m["y"], w0=m["w0"])
+    out = tmp_path / "sel"
+    assert main(["select", str(src), "--na", "1-2", "--nb", "1", "--k", "2,3", "--lines", "1-243",
+                 "--workers", "1", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "choice (MDL): na = 2, nb = 1, k = 3" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["choice"] == {"na": 2, "nb": 1, "k": 3} and summary["choice_ok"]
+    assert lptv.Model.load(out / "model.json").na == 2
+    assert (out / "selection.csv").read_text().splitlines()[0].startswith("rank,na,nb,k")
+    # every candidate rejected: the least bad is written, exit status 1
+    assert main(["select", str(src), "--na", "1", "--nb", "0", "--k", "0", "--lines", "1-243",
+                 "--workers", "1", "--out", str(out)]) == 1
+    assert "EVERY candidate" in capsys.readouterr().out
+    for bad, what in ((["--na", "2-1"], "--na"), (["--refine", "-1"], "--refine"), (["--k", "x"], "--k")):
+        assert main(["select", str(src), "--workers", "1", "--out", str(out)] + bad) == 2
+        assert what in capsys.readouterr().err
+    assert main(["select", str(tmp_path / "missing.npz"), "--workers", "1"]) == 2
+    assert "missing.npz: no such file" in capsys.readouterr().err
