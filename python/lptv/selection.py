@@ -1,6 +1,7 @@
 """Choosing the structure: orders and harmonic count from the data (METHOD.md section 13)."""
 from __future__ import annotations
 
+import concurrent.futures as cf
 import math
 import time
 import warnings
@@ -10,7 +11,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ._validate import as_int, as_positive_float, as_str
-from .batch.executors import describe_executor, one_blas_thread, require, run_tasks
+from .batch.executors import available_cores, describe_executor, one_blas_thread, require, run_tasks
 from .data import FrequencyData, frequency_data_of
 from .identify import IdentificationResult, _rows, identify
 from .nonparametric import HtfEstimate, htf_estimate
@@ -263,29 +264,18 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
     shared = dict(U=data.U, Y=data.Y, varU=data.varU, varY=data.varY, covYU=data.covYU, w0=data.w0,
                   ts=data.ts, periods=P, lines=rows, tol=tol, max_iter=max_iter, c=c)
     grid = [(a, b, kk, "wgtls") for a in na_list for b in nb_list for kk in k_list]
-    out = run_tasks(fit_structure, grid, shared, executor=executor, workers=workers, progress=progress,
-                    desc="select: WGTLS", unit="fit")
-    scored = [r if isinstance(r, dict) else _failed(item, r) for item, r in zip(grid, out)]
-    if all(r["error"] for r in scored):
-        raise ValueError(f"every structure failed to fit; the first: {scored[0]['error']}")
-    for r in scored:
-        r["V_wgtls"] = r["V"]
-    if refine:
-        # the shortlist per harmonic count: the diagonal WGTLS cost ignores the correlation of
-        # rows that share lines, which grows with k, and drops far more than the exact cost when k
-        # is overestimated; its scores are compared within one k only
-        ordered = [r for r in sorted(scored, key=_key(criterion)) if not r["error"]]
-        best = [r for kk in k_list for r in [r for r in ordered if r["k"] == kk][:refine]]
-        items = [(r["na"], r["nb"], r["k"], "sml") for r in best]
-        out = run_tasks(fit_structure, items, shared, executor=executor, workers=workers, progress=progress,
-                        desc="select: SML", unit="fit")
-        for item, r, w in zip(items, out, best):
-            new = r if isinstance(r, dict) else _failed(item, r)
-            new["V_wgtls"] = w["V"]
-            scored[scored.index(w)] = new
-    ranked = sorted(scored, key=_key(criterion))
-    ranked = tuple({"rank": i + 1, **{c_: r[c_] for c_ in COLUMNS if c_ != "rank"}}
-                   for i, r in enumerate(ranked))
+    label = describe_executor(executor, workers)
+    # one pool of processes for both stages (run_tasks leaves an executor it is given open)
+    pool = None
+    if workers is not None:      # run_tasks's own check of workers (and of the executor it needs)
+        run_tasks(fit_structure, [], None, executor=executor, workers=workers)
+    if executor == "processes":
+        pool = cf.ProcessPoolExecutor(max_workers=workers or available_cores())
+    try:
+        scored, ranked = _rank(grid, k_list, shared, criterion, refine, pool or executor, progress)
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True)
     top = ranked[0]
     choice = (top["na"], top["nb"], top["k"])
     choice_ok = bool(top["residue_ok"])
@@ -303,6 +293,32 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
         restore()
     return SelectionResult(rows=ranked, choice=choice, result=res, criterion=criterion,
                            lines=np.asarray(rows), correction=c, choice_ok=choice_ok, htf=est,
-                           htf_harmonics=k_htf, warnings=tuple(notes),
-                           executor=describe_executor(executor, workers),
+                           htf_harmonics=k_htf, warnings=tuple(notes), executor=label,
                            elapsed=time.perf_counter() - t_start)
+
+
+def _rank(grid, k_list, shared, criterion, refine, executor, progress):
+    """WGTLS on the grid, SML on the shortlist; (scored rows, ranked rows)."""
+    out = run_tasks(fit_structure, grid, shared, executor=executor, progress=progress,
+                    desc="select: WGTLS", unit="fit")
+    scored = [r if isinstance(r, dict) else _failed(item, r) for item, r in zip(grid, out)]
+    if all(r["error"] for r in scored):
+        raise ValueError(f"every structure failed to fit; the first: {scored[0]['error']}")
+    for r in scored:
+        r["V_wgtls"] = r["V"]
+    if refine:
+        # the shortlist per harmonic count: the diagonal WGTLS cost ignores the correlation of
+        # rows that share lines, which grows with k, and drops far more than the exact cost when k
+        # is overestimated; its scores are compared within one k only
+        ordered = [r for r in sorted(scored, key=_key(criterion)) if not r["error"]]
+        best = [r for kk in k_list for r in [r for r in ordered if r["k"] == kk][:refine]]
+        items = [(r["na"], r["nb"], r["k"], "sml") for r in best]
+        out = run_tasks(fit_structure, items, shared, executor=executor, progress=progress,
+                        desc="select: SML", unit="fit")
+        for item, r, w in zip(items, out, best):
+            new = r if isinstance(r, dict) else _failed(item, r)
+            new["V_wgtls"] = w["V"]
+            scored[scored.index(w)] = new
+    ranked = sorted(scored, key=_key(criterion))
+    return scored, tuple({"rank": i + 1, **{c_: r[c_] for c_ in COLUMNS if c_ != "rank"}}
+                         for i, r in enumerate(ranked))
