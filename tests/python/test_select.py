@@ -3,7 +3,7 @@
 Counts measured when these tests were written (the seeds below, lines 1..243, P = 8):
 MDL recovered the paper example's (2, 1, 3) in 10 of 10 seeds (1..10) on the grid
 na 1..3, nb 0..2, k 0..4, and the LTI system's (2, 1, 0) in 10 of 10 on na 1..3, nb 0..2,
-k 0..2; AIC in 4 of 10 and 4 of 10 (it keeps unneeded harmonics: see METHOD.md section 13).
+k 0..2 (and in 10 of 10 with k from the HTF guide, i.e. k = 0); AIC in 4 of 10 and 4 of 10 (it keeps unneeded harmonics: see METHOD.md section 13).
 The tests run 5 seeds each and ask for at least 4.
 """
 import numpy as np
@@ -56,13 +56,15 @@ def test_lti_structure_recovered_in_most_seeds():
     hits = 0
     for seed in SEEDS:
         u, y = lti_measurements(seed)
-        sel = lptv.select(u, y, w0=0.04, na=range(1, 4), nb=range(0, 3), lines=LINES, executor="serial",
-                          progress=False)                      # k from the HTF guide
+        sel = lptv.select(u, y, w0=0.04, na=range(1, 4), nb=range(0, 3), k=range(0, 3), lines=LINES,
+                          executor="serial", progress=False)
         check_ranking(sel)
         assert sel.htf_harmonics == 0 and sel.htf.branches == 4
-        assert {r["k"] for r in sel.rows} == {0}
         hits += sel.choice == (2, 1, 0)
     assert hits >= 4, f"(2, 1, 0) chosen in {hits} of {len(SEEDS)} seeds"
+    # without k the HTF guide (only branch 0 above the noise) gives the grid k = 0
+    sel = lptv.select(u, y, w0=0.04, na=[2], nb=[1, 2], lines=LINES, executor="serial", progress=False)
+    assert {r["k"] for r in sel.rows} == {0} and sel.choice == (2, 1, 0)
 
 
 def test_htf_guide_sets_the_harmonic_grid_and_default_rows_follow_the_largest_k():
@@ -179,3 +181,16 @@ def test_cli_select(tmp_path, capsys):
         assert what in capsys.readouterr().err
     assert main(["select", str(tmp_path / "missing.npz"), "--workers", "1"]) == 2
     assert "missing.npz: no such file" in capsys.readouterr().err
+
+
+def test_readme_select_example_runs():
+    import re
+    from pathlib import Path
+
+    readme = Path(__file__).resolve().parents[2] / "README.md"
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", readme.read_text(), flags=re.S)
+              if "lptv.select(" in b]
+    assert len(blocks) == 1
+    ns = {}
+    exec(compile(blocks[0], "README.md", "exec"), ns)
+    assert ns["sel"].choice == (2, 1, 3) and ns["sel"].result.method == "sml"
