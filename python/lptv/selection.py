@@ -28,7 +28,7 @@ MAX_GUIDE_BRANCHES = 10
 class SelectionResult:
     """What :func:`select` returns: the ranked candidates and the chosen structure."""
 
-    rows: Tuple[dict, ...]
+    rows: Tuple[dict, ...] = field(repr=False)
     """One dict per candidate (keys ``COLUMNS``), best first: sorted by (passes the residue test,
     refined by SML, the criterion, the number of parameters); failed fits last."""
     choice: Tuple[int, int, int]
