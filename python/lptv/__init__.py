@@ -9,6 +9,7 @@ The public API:
   SML on the exact likelihood) with the covariance of the estimate;
 - :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
 - :func:`htf_estimate` - the harmonic transfer function's branches from data, without a model;
+- :func:`select` - the orders and harmonic count from the data (a ranked grid of structures);
 - :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
 - :func:`montecarlo`, :func:`identify_many` - Monte Carlo studies and many records at once, on
@@ -23,6 +24,7 @@ from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, ide
 from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
 from .floquet import FloquetResult, floquet
+from .selection import SelectionResult, select
 from .measurements import Measurements, read_measurements
 from .model import Model
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
@@ -36,5 +38,5 @@ __all__ = [
     "IdentificationResult", "Model", "MonteCarloResult", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
     "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
     "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",
-    "simulate", "spectrum", "time_signal",
+    "select", "SelectionResult", "simulate", "spectrum", "time_signal",
 ]

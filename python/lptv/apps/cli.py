@@ -4,6 +4,7 @@
     lptv demo lecture [--out DIR] [--quick]               the lecture's cases
     lptv identify FILE --na 2 --nb 1 ...                  a model from your own measurements
     lptv identify FILES... [--workers N | --scheduler ADDRESS]   many files, one row each
+    lptv select FILE --na 1-3 --nb 0-2 [--k 0-4]          choose the orders and harmonic count
     lptv montecarlo --runs R --periods P --method wgtls,sml [--scheduler ADDRESS]
                                                           a Monte Carlo study of the estimators
 """
@@ -39,6 +40,9 @@ def main(argv=None) -> int:
     from lptv.apps import montecarlo
 
     montecarlo.add_parser(sub)
+    from lptv.apps import choose
+
+    choose.add_parser(sub)
     args = parser.parse_args(argv)
     if args.command == "demo":
         if args.monte_carlo < 0:
@@ -56,6 +60,8 @@ def main(argv=None) -> int:
         return fileid.run(args)
     if args.command == "montecarlo":
         return montecarlo.run(args)
+    if args.command == "select":
+        return choose.run(args)
     parser.error(f"unknown command {args.command}")
     return 2
 

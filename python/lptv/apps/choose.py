@@ -1,0 +1,134 @@
+"""``lptv select FILE``: choose the orders and the harmonic count from a measurement file.
+
+Fits every structure of the grid ``--na`` x ``--nb`` x ``--k`` (ranges like ``1-3`` or lists like
+``0,2``; without ``--k`` the nonparametric HTF of the data sets it) with :func:`lptv.select`,
+prints the ranking and the choice, and writes into ``--out`` (default ``<file stem>-select/``):
+``selection.csv`` (the ranked table), ``model.json`` (the chosen structure's fit) and
+``summary.json``. The file formats and the period options are those of ``lptv identify``.
+Exit status 0 with a choice the residue test accepts, 1 when every candidate is rejected (the
+least bad is still written), 2 for bad options or files.
+
+Example (the paper's simulation example as a measurement file)::
+
+    python -c "import numpy as np, lptv.examples as ex; m = ex.paper_measurements(); \\
+               np.savez('meas.npz', u=m['u'], y=m['y'], w0=m['w0'])"
+    lptv select meas.npz --na 1-3 --nb 0-2 --k 1-4 --lines 1-243 --workers 2
+"""
+from __future__ import annotations
+
+import csv
+import re
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from lptv import read_measurements, select
+from lptv.apps.fileid import parse_lines, positive
+from lptv.apps.manyid import executor_of
+from lptv.apps.report import write_json
+from lptv.measurements import FileError
+
+
+def parse_grid(text, opt):
+    """'1-3', '0,2' or '2' -> the sorted values."""
+    out = []
+    for tok in str(text).split(","):
+        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", tok)
+        if not m or (m.group(2) and int(m.group(2)) < int(m.group(1))):
+            raise FileError(f"{opt}: '{tok.strip()}' is not a non-negative integer or a range like 1-3")
+        out.extend(range(int(m.group(1)), int(m.group(2) or m.group(1)) + 1))
+    if len(set(out)) != len(out):
+        raise FileError(f"{opt}: a value is given twice in '{text}'")
+    return sorted(out)
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        "select", help="choose the orders and harmonic count of a model from a measurement file",
+        description="Fits a grid of structures (na, nb, k harmonics on every coefficient) by WGTLS, "
+                    "the best per k again by SML, ranks them by MDL (or AIC) with the residue test "
+                    "first, and writes the ranking and the chosen model.")
+    p.add_argument("file", metavar="FILE", help="measurements: .csv, .npz or .mat (as for lptv identify)")
+    p.add_argument("--na", default="1-3", help="orders of the output side to try (default 1-3)")
+    p.add_argument("--nb", default="0-2", help="orders of the input side to try (default 0-2)")
+    p.add_argument("--k", help="harmonic counts to try, e.g. 0-4 (default: from the data's HTF branches)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--w0", type=float, help="fundamental of the period (rad/s)")
+    g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
+    p.add_argument("--ts", type=float, help="sample period: discrete-time models")
+    p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
+    p.add_argument("--lines", help="rows of every fit, e.g. 1-243 (default: those of the largest k)")
+    p.add_argument("--criterion", default="mdl", choices=["mdl", "aic"], help="ranking criterion (default mdl)")
+    p.add_argument("--refine", type=int, default=2, metavar="N",
+                   help="structures per harmonic count refitted by SML (default 2; 0: WGTLS only)")
+    p.add_argument("--out", help="output folder (default: <file stem>-select/)")
+    b = p.add_mutually_exclusive_group()
+    b.add_argument("--workers", type=int, metavar="N", help="local processes (default: all cores; 1: serially)")
+    b.add_argument("--scheduler", metavar="ADDRESS", help="a Dask cluster, e.g. tcp://10.0.0.5:8786")
+    return p
+
+
+def _error(problem) -> int:
+    print(f"lptv select: error: {' '.join(str(problem).split()) or type(problem).__name__}", file=sys.stderr)
+    return 2
+
+
+def _w0(args, meas):
+    w0 = positive(args.w0, "--w0")
+    if positive(args.period, "--period") is not None:
+        w0 = 2 * np.pi / args.period
+    if meas.w0 is not None:
+        if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
+            raise FileError(f"the options give w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
+        w0 = meas.w0
+    if positive(args.ts, "--ts") is not None and w0 is None:
+        w0 = 2 * np.pi / (meas.u.shape[1] * args.ts)
+    if w0 is None:
+        raise FileError("the period is unknown: give --w0 (rad/s) or --period (s)")
+    return float(w0)
+
+
+def run(args) -> int:
+    src = args.file
+    try:
+        na, nb = parse_grid(args.na, "--na"), parse_grid(args.nb, "--nb")
+        k = parse_grid(args.k, "--k") if args.k is not None else None
+        lines = parse_lines(args.lines) if args.lines is not None else None
+        if args.refine < 0:
+            raise FileError(f"--refine must be >= 0, got {args.refine}")
+        executor, workers = executor_of(args)
+        meas = read_measurements(src, args.periods)
+        w0 = _w0(args, meas)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")      # the result says the same in its warnings
+            sel = select(meas.u, meas.y, w0=w0, ts=args.ts, na=na, nb=nb, k=k, lines=lines,
+                         criterion=args.criterion, refine=args.refine, executor=executor, workers=workers)
+    except FileError as e:
+        return _error(f"{src}: {e}")
+    except (ValueError, ImportError) as e:
+        return _error(e)
+    out = Path(args.out) if args.out else Path(Path(src).stem + "-select")
+    P, N = meas.u.shape
+    print(f"lptv select: {src} ({meas.format}, {P} periods of {N} samples, w0 = {w0:.6g} rad/s), "
+          f"{len(sel.rows)} structures on {sel.lines.size} lines, {sel.executor}, {sel.elapsed:.1f} s -> {out}/")
+    print(sel.summary())
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with open(out / "selection.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(sel.rows[0]))
+            w.writeheader()
+            w.writerows(sel.rows)
+        sel.result.model.save(out / "model.json")
+        write_json(out / "summary.json", {
+            "file": str(src), "periods": P, "samples_per_period": N, "w0": w0, "ts": args.ts,
+            "criterion": sel.criterion, "choice": dict(zip(("na", "nb", "k"), sel.choice)),
+            "choice_ok": sel.choice_ok, "method": sel.result.method, "n_lines": int(sel.lines.size),
+            "correction": sel.correction, "htf_harmonics": sel.htf_harmonics,
+            "structures": len(sel.rows), "executor": sel.executor, "seconds": sel.elapsed,
+            "warnings": list(sel.warnings)})
+    except OSError as e:
+        return _error(f"{e.filename or out}: {e.strerror or e}")
+    print(f"wrote {out / 'selection.csv'}, {out / 'model.json'}, {out / 'summary.json'}")
+    return 0 if sel.choice_ok else 1
