@@ -7,8 +7,55 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core
-from ._validate import as_int
-from .data import frequency_data_of
+from ._validate import as_int, as_str
+from .data import FrequencyData, frequency_data_of
+
+
+def _lpm_data(u, y, w0, ts, degree, width):
+    """Spectra and noise (co)variances of periodic lines 0..N/2 by the local polynomial method.
+
+    The P periods form one record of P N samples; its DFT X_j = fft(x)[j] / (P N) has the
+    periodic response on the bins j = P m only, where X_{P m} equals the period's line m. Around
+    each such bin a polynomial in r (bins j + r, 0 < |r| <= width) is fitted by least squares to
+    the non-periodic bins, which hold only the transient (smooth) and noise; its value at r = 0 is
+    the transient on line m. The noise variance of one bin is the residual power over the residual
+    degrees of freedom, and the corrected line carries it times 1 + h (h the leverage of r = 0).
+    """
+    src = FrequencyData.from_periods(u, y, w0=w0, ts=ts)  # validates shapes, w0, ts
+    u = np.asarray(u, float)
+    y = np.asarray(y, float)
+    P, N = u.shape
+    degree = as_int(degree, "degree")
+    width = P - 1 if width is None else as_int(width, "width", minimum=1)
+    if width > P - 1:
+        raise ValueError(f"width must be at most P - 1 = {P - 1} (the bins before the next periodic line), "
+                         f"got {width}")
+    n_fit = 2 * width
+    if n_fit <= degree + 1:
+        raise ValueError(f"degree {degree} needs more than {degree + 1} bins around each line; "
+                         f"width {width} gives {n_fit}: use more periods or a lower degree")
+    r = np.concatenate([np.arange(-width, 0), np.arange(1, width + 1)])
+    A = np.vander(r / width, degree + 1, increasing=True)          # (2 width, degree + 1)
+    pinv = np.linalg.pinv(A)                                         # (degree + 1, 2 width)
+    h0 = float(np.linalg.inv(A.T @ A)[0, 0])
+    lines = np.arange(N // 2 + 1)
+    bins = (P * lines)[:, None] + r[None, :]                         # negative bins wrap: conj
+    out = {}
+    for name, x in (("U", u), ("Y", y)):
+        X = np.fft.fft(x.reshape(-1)) / (P * N)
+        nb = X[bins]                                                 # (lines, 2 width)
+        c = nb @ pinv.T
+        out[name] = X[P * lines] - c[:, 0]
+        out["e" + name] = nb - c @ A.T
+    dof = n_fit - (degree + 1)
+    k = (1.0 + h0) / dof
+    varU = k * np.sum(np.abs(out["eU"]) ** 2, axis=1)
+    varY = k * np.sum(np.abs(out["eY"]) ** 2, axis=1)
+    covYU = k * np.sum(out["eY"] * np.conj(out["eU"]), axis=1)
+    U, Y = out["U"], out["Y"]
+    U[0], Y[0], covYU[0] = U[0].real, Y[0].real, covYU[0].real
+    data = FrequencyData(U, Y, varU, varY, covYU, w0=src.w0, ts=ts, periods=0)
+    return data, dof
 
 
 @dataclass(frozen=True)
@@ -30,6 +77,8 @@ class HtfEstimate:
     p_value: np.ndarray
     """Per branch: probability of a statistic this large if the branch were zero."""
     periods: int
+    method: str = "ratio"
+    """'ratio' (means of steady-state periods) or 'lpm' (local polynomial method)."""
 
     @property
     def k(self) -> np.ndarray:
@@ -47,7 +96,8 @@ class HtfEstimate:
 
 
 def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] = None,
-                 excited: Optional[Sequence[int]] = None, branches: int = 0) -> HtfEstimate:
+                 excited: Optional[Sequence[int]] = None, branches: int = 0, method: str = "ratio",
+                 degree: int = 2, width: Optional[int] = None) -> HtfEstimate:
     """Estimate the harmonic transfer function's branches from steady-state periods, without a model.
 
     An LPTV system maps input line i to output lines i + k (METHOD.md section 11). When the
@@ -69,6 +119,17 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     branches : int
         Kh: branches k = -Kh..Kh are estimated. The excited lines must be more than 2 Kh apart and
         above Kh (a ``ValueError`` says which lines are too close).
+    method : {'ratio', 'lpm'}
+        'ratio': the spectra are the means of the P periods, their variances those of the means.
+        'lpm': the local polynomial method for records that are not in steady state (a start-up
+        transient): the P periods are taken as one record of P N samples, whose DFT has the
+        periodic response on every P-th bin only; the transient (and leakage) is smooth across
+        bins, so a polynomial of ``degree`` fitted to the ``width`` bins on each side of each
+        periodic line (none of them periodic lines) gives the transient on the line, which is
+        subtracted, and the fit's residual gives the noise (co)variances (METHOD.md section 11).
+    degree, width : int
+        LPM only: the polynomial degree (default 2) and the bins on each side (default P - 1, all
+        those before the next periodic line; 2 width must exceed degree + 1).
 
     Notes
     -----
@@ -96,7 +157,16 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     """
     from scipy import stats
 
-    data = frequency_data_of(u, y, w0, ts)
+    method = as_str(method, "method", ("ratio", "lpm"))
+    dof = None
+    if method == "lpm":
+        if y is None or isinstance(u, FrequencyData):
+            raise ValueError("method='lpm' needs the periods u and y of shape (P, N), not a FrequencyData")
+        if w0 is None:
+            raise ValueError("w0 is missing: the fundamental of the period (rad/s)")
+        data, dof = _lpm_data(u, y, w0, ts, degree, width)
+    else:
+        data = frequency_data_of(u, y, w0, ts)
     branches = as_int(branches, "branches", maximum=data.max_line)
     if excited is None:
         lines = [int(v) for v in _core.excited_lines(data._cpp)]
@@ -111,8 +181,12 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     n = len(h.lines)
     stat = np.asarray(h.branch_statistic)
     P = data.periods
-    scale = (P - 1) / (P - 2) if P and P > 2 else 1.0
+    # each |G_k|^2 / var G_k of a zero branch is F(2, 2 q) with q the variance's complex degrees
+    # of freedom (P - 1 for the means of periods; the LPM fit's residual count minus its unknowns)
+    q = dof if dof is not None else (P - 1 if P and P > 1 else 0)
+    scale = q / (q - 1) if q > 1 else 1.0
     p = stats.gamma.sf(stat / scale, n)
     lines = np.asarray(h.lines)
     return HtfEstimate(lines=lines, w=lines * data.w0, branches=h.branches, G=np.asarray(h.G),
-                       std=np.sqrt(np.asarray(h.variance)), statistic=stat, p_value=p, periods=P)
+                       std=np.sqrt(np.asarray(h.variance)), statistic=stat, p_value=p,
+                       periods=np.shape(u)[0] if method == "lpm" else P, method=method)
