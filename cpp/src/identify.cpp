@@ -59,6 +59,20 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0, double
 
 Identification identify(const FrequencyData& d, const Structure& s, const IdentifyOptions& opt) {
   d.validate();
+  s.validate();
+  if (!opt.rows.empty()) check_row_lines(s, opt.rows, d.max_line());
+  {
+    // Equations against unknowns before anything is allocated for the structure.
+    const long long K = s.kmax();
+    const long long n_rows = opt.rows.empty() ? std::max(0LL, d.max_line() - 2 * K)
+                                              : static_cast<long long>(opt.rows.size());
+    if (2 * n_rows <= s.n_unknowns()) {
+      throw std::invalid_argument(
+          "the orders and harmonic counts leave " + std::to_string(s.n_unknowns()) + " free parameters for " +
+          std::to_string(2 * n_rows) + " real equations (" + std::to_string(n_rows) +
+          " lines): use more lines or fewer harmonics / lower orders");
+    }
+  }
   const Parametrisation p(s);
   const std::vector<int> rows = opt.rows.empty() ? default_rows(p, d.max_line()) : opt.rows;
   check_rows(p, rows, d.max_line());

@@ -25,6 +25,26 @@ int Structure::kmax() const {
   return k;
 }
 
+long long Structure::n_complex_parameters() const {
+  long long n = 0;
+  for (int v : ka) n += 2LL * v + 1;
+  for (int v : kb) n += 2LL * v + 1;
+  return n;
+}
+
+long long Structure::n_unknowns() const {
+  long long n = 0;
+  for (int side = 0; side < 2; ++side) {
+    const std::vector<int>& K = side == 0 ? ka : kb;
+    for (int c = 0; c < static_cast<int>(K.size()); ++c) {
+      bool is_known = false;
+      for (const auto& kn : known) is_known = is_known || (kn.is_a == (side == 0) && kn.order == c);
+      if (!is_known) n += 2LL * K[c] + 1;
+    }
+  }
+  return known.empty() ? n - 1 : n;
+}
+
 void Structure::validate() const {
   if (na < 0) throw std::invalid_argument("na must be >= 0, got " + std::to_string(na));
   if (nb < 0) throw std::invalid_argument("nb must be >= 0, got " + std::to_string(nb));
@@ -52,8 +72,8 @@ void Structure::validate() const {
       throw std::invalid_argument("known: " + nm + " is given twice");
     }
     const int K = kn.is_a ? ka[kn.order] : kb[kn.order];
-    if (kn.coef.size() != 2 * K + 1) {
-      throw std::invalid_argument("known: " + nm + " needs " + std::to_string(2 * K + 1) +
+    if (kn.coef.size() != 2LL * K + 1) {
+      throw std::invalid_argument("known: " + nm + " needs " + std::to_string(2LL * K + 1) +
                                   " Fourier values (its harmonic count is " + std::to_string(K) +
                                   "), got " + std::to_string(kn.coef.size()));
     }
@@ -72,6 +92,18 @@ void Structure::validate() const {
 
 Parametrisation::Parametrisation(const Structure& s) : s_(s) {
   s_.validate();
+  // The parametrisation is dense (n_theta x n_eta complex): refuse sizes that would exhaust
+  // memory before allocating anything (na = 6000 took 1.2 GB before the rows check refused it).
+  constexpr long long kMaxParameters = 4000;
+  const long long n = s_.n_complex_parameters();
+  if (n > kMaxParameters) {
+    const double gb = 16.0 * static_cast<double>(n) * static_cast<double>(n) / 1e9;
+    throw std::invalid_argument(
+        "the orders and harmonic counts give " + std::to_string(n) + " complex parameters (at most " +
+        std::to_string(kMaxParameters) + "): their parametrisation alone would take " +
+        std::to_string(gb).substr(0, std::to_string(gb).find('.') + 2) +
+        " GB; lower na, nb or the harmonic counts");
+  }
   auto is_known = [&](bool is_a, int order) -> const Structure::Known* {
     for (const auto& kn : s_.known) if (kn.is_a == is_a && kn.order == order) return &kn;
     return nullptr;
@@ -248,8 +280,20 @@ std::vector<int> default_rows(const Parametrisation& p, int max_line) {
 }
 
 void check_rows(const Parametrisation& p, const std::vector<int>& rows, int max_line) {
+  check_row_lines(p.structure(), rows, max_line);
+  const long long eq = 2 * static_cast<long long>(rows.size());
+  const long long unknowns = p.n_xi() - 1;
+  if (eq <= unknowns) {
+    throw std::invalid_argument(
+        "the orders and harmonic counts leave " + std::to_string(unknowns) + " free parameters for " +
+        std::to_string(eq) + " real equations (" + std::to_string(rows.size()) +
+        " lines): use more lines or fewer harmonics / lower orders");
+  }
+}
+
+void check_row_lines(const Structure& s, const std::vector<int>& rows, int max_line) {
   // 64-bit: a row near INT_MAX plus K must not wrap around and pass the check.
-  const long long K = p.structure().kmax();
+  const long long K = s.kmax();
   if (rows.empty()) throw std::invalid_argument("lines: no rows to fit");
   std::set<int> seen;
   for (const long long l : rows) {
@@ -267,14 +311,6 @@ void check_rows(const Parametrisation& p, const std::vector<int>& rows, int max_
                                   std::to_string(l - K) + " beyond the data");
     }
     if (!seen.insert(static_cast<int>(l)).second) throw std::invalid_argument("lines: row " + std::to_string(l) + " repeats");
-  }
-  const long long eq = 2 * static_cast<long long>(rows.size());
-  const long long unknowns = p.n_xi() - 1;
-  if (eq <= unknowns) {
-    throw std::invalid_argument(
-        "the orders and harmonic counts leave " + std::to_string(unknowns) + " free parameters for " +
-        std::to_string(eq) + " real equations (" + std::to_string(rows.size()) +
-        " lines): use more lines or fewer harmonics / lower orders");
   }
 }
 

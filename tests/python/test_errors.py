@@ -375,3 +375,32 @@ def test_a_row_near_int_max_is_refused_not_read_out_of_bounds():
     """)
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert p.returncode == 0 and p.stdout.strip() == "ok", (p.returncode, p.stderr[-2000:])
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(na=6000, nb=0), "6001 free parameters for 256 real equations"),
+    (dict(na=1, nb=0, ka=2**31 - 1), "8589934590 free parameters"),
+    (dict(na=1, nb=0, ka=1500, lines=range(1, 100)), "3003 free parameters"),
+])
+def test_structures_too_large_for_the_data_are_refused_before_allocating(kw, match):
+    """Equations against unknowns in 64-bit arithmetic before the parametrisation is built (na=6000
+    allocated 1.2 GB before this check; a harmonic count near INT_MAX grew without bound)."""
+    import resource
+
+    m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)
+    ms = lptv.multisine(range(1, 60), 256, seed=0)
+    y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
+    rng = np.random.default_rng(1)
+    u = ms.periods(4) + 1e-3 * rng.standard_normal((4, 256))
+    y = np.tile(y1, (4, 1)) + 1e-3 * rng.standard_normal((4, 256))
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(ValueError, match=match):
+        lptv.identify(u, y, w0=0.1, **kw)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100_000  # KB: < 100 MB
+
+
+def test_a_parametrisation_beyond_the_size_limit_says_how_much_memory():
+    from lptv import _core
+
+    with pytest.raises(ValueError, match="complex parameters .* GB"):
+        _core.Parametrisation(2, 0, [1500, 1500, 1500], [0], [], 0.1, 0.0)

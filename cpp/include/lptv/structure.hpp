@@ -27,6 +27,10 @@ struct Structure {
   double ts = 0.0;  // 0: continuous time
 
   int kmax() const;
+  // Complex parameters (every harmonic of every coefficient, known ones included) and the free
+  // real unknowns after the normalisation, in 64-bit arithmetic (no allocation).
+  long long n_complex_parameters() const;
+  long long n_unknowns() const;
   // Throws std::invalid_argument naming what is wrong.
   void validate() const;
 };
@@ -90,5 +94,8 @@ std::vector<int> default_rows(const Parametrisation& p, int max_line);
 // Throws std::invalid_argument when rows are not >= 1, repeat, or need lines
 // beyond the data (|l +- K| > Lmax), or leave fewer equations than unknowns.
 void check_rows(const Parametrisation& p, const std::vector<int>& rows, int max_line);
+// The per-row part of check_rows (lines >= 1, within the data for K harmonics, no repeats),
+// from the structure alone: no parametrisation is built.
+void check_row_lines(const Structure& s, const std::vector<int>& rows, int max_line);
 
 }  // namespace lptv
