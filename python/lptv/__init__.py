@@ -23,8 +23,9 @@ from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, ide
 from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
 from .floquet import FloquetResult, floquet
-from .measurements import Measurements, read_measurements
+from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
 from .model import Model
+from .parameters import lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import Multisine, multisine, spectrum, time_signal
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
@@ -36,5 +37,6 @@ __all__ = [
     "IdentificationResult", "Model", "MonteCarloResult", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
     "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
     "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",
-    "simulate", "spectrum", "time_signal",
+    "simulate", "spectrum", "time_signal", "check_record", "RecordCheck", "RecordWarning",
+    "lti_table", "parameter_table",
 ]
