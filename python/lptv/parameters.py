@@ -247,3 +247,88 @@ def format_parameter_table(obj, level: float = 0.95) -> str:
             lines.append(f"  pole {pole}{sd}: natural frequency {_num(p['wn'], p['wn_std'])} rad/s "
                          f"= {_num(p['f_hz'], p['f_std'])} Hz, damping {_num(p['zeta'], p['zeta_std'])}")
     return "\n".join(lines)
+
+
+def perturbed_model(model, name: str, delta: float):
+    """A copy of ``model`` with the real parameter ``name`` (e.g. 'a0.re1') moved by ``delta``."""
+    from .model import Model
+
+    side, n, part, k = _parse(name)
+    a, b = model.a.copy(), model.b.copy()
+    arr, K = (a, model.ka) if side == "a" else (b, model.kb)
+    step = delta if part == "re" else 1j * delta
+    arr[n, K + k] += step
+    if k:
+        arr[n, K - k] += np.conj(step)
+    return Model(a, b, w0=model.w0, ts=model.ts)
+
+
+def freqresp_band(obj, w, *, level: float = 0.95, branch: int = 0):
+    """The model's frequency response at ``w`` with the standard deviation of its magnitude and
+    phase (first order, central differences over the parameters): ``(H, std_abs, std_phase_rad)``;
+    the stds are None without a covariance."""
+    model, names, eta, cov = _source(obj)
+    H = model.freqresp(w, branch=branch)
+    if cov is None or not names:
+        return H, None, None
+    J = np.zeros((2 * H.size, len(names)))
+    for i, name in enumerate(names):
+        if cov[i, i] <= 0:
+            continue
+        h = 1e-6 * max(abs(eta[i]), 1e-3)
+        Hp = perturbed_model(model, name, h).freqresp(w, branch=branch)
+        Hm = perturbed_model(model, name, -h).freqresp(w, branch=branch)
+        dH = (Hp - Hm) / (2 * h)
+        J[:H.size, i] = np.real(dH * np.conj(H)) / np.maximum(np.abs(H), 1e-300)
+        J[H.size:, i] = np.imag(dH / np.where(H == 0, 1, H))
+    V = np.einsum("ij,jk,ik->i", J, cov, J)
+    s = np.sqrt(np.maximum(V, 0.0))
+    return H, s[:H.size], s[H.size:]
+
+
+def compare(obj, u, y):
+    """Simulated against measured output over one period, and the fit in percent.
+
+    The model's output is simulated from the mean measured input period (in steady state, on the
+    frequency grid of the period); the fit is ``100 (1 - ||y - yhat|| / ||y - mean y||)`` with
+    ``y`` the mean measured output period (MATLAB's ``compare``). 100 for a perfect model on
+    noise-free data; the noise of the mean output lowers it.
+
+    Parameters
+    ----------
+    obj : IdentificationResult or Model
+    u, y : array_like, shape (P, N) or (N,)
+        Periods of the measured input and output (the fit's, or fresh validation data).
+
+    Returns
+    -------
+    dict with ``t`` (s), ``y`` (mean measured period), ``y_model``, ``fit`` (percent).
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> m = lptv.Model.from_tf([1.0], [1.0, 2.0], w0=2 * np.pi / 25.6)
+    >>> ms = lptv.multisine(range(1, 60), 256, seed=0)
+    >>> u = ms.periods(2); y = np.tile(lptv.time_signal(lptv.simulate(m, ms.spectrum), 256), (2, 1))
+    >>> round(lptv.compare(m, u, y)["fit"], 9)
+    100.0
+    """
+    from .fds import simulate
+    from .multisine import spectrum, time_signal
+
+    model = _source(obj)[0]
+    u, y = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(y, float))
+    if u.shape != y.shape or u.ndim != 2:
+        raise ValueError(f"u and y must have the same shape (P, N) or (N,), got {u.shape} and {y.shape}")
+    N = u.shape[1]
+    um, ym = u.mean(axis=0), y.mean(axis=0)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        Y = simulate(model, spectrum(um))
+    yhat = time_signal(np.asarray(Y)[: N // 2 + 1], N)
+    den = np.linalg.norm(ym - ym.mean())
+    fit = 100.0 * (1.0 - np.linalg.norm(ym - yhat) / den) if den > 0 else float("nan")
+    t = np.arange(N) * (model.period / N)
+    return {"t": t, "y": ym, "y_model": yhat, "fit": float(fit)}

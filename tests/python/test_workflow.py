@@ -280,3 +280,46 @@ def test_time_signal_of_simulate_works_for_every_n(n):
     Y = lptv.simulate(m, ms.spectrum)
     y = lptv.time_signal(Y, n)
     assert y.shape == (n,) and np.all(np.isfinite(y))
+
+
+# ------------------------------------------------------------------------------ 5. look at the fit
+
+def test_compare_fit_of_the_true_model_on_noise_free_data_is_100():
+    true = lptv.Model.from_tf(NUM, DEN, w0=W0)
+    ms = lptv.multisine(range(1, 51), N, seed=3)
+    u = ms.periods(2)
+    y = np.tile(lptv.time_signal(lptv.simulate(true, ms.spectrum), N), (2, 1))
+    c = lptv.compare(true, u, y)
+    assert c["fit"] == pytest.approx(100.0, abs=1e-9)
+    assert lptv.compare(lptv.Model.from_tf(NUM, [1.0, 4.0, 110.0], w0=W0), u, y)["fit"] < 90
+
+
+def test_bode_and_report_show_the_fit(record, tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    from lptv import plots
+
+    u, y = record
+    res = lptv.identify(u, y, na=2, nb=0, w0=W0, method="sml")
+    fig = plots.bode(res, hz=True)
+    ax_m, ax_p = fig.axes
+    assert ax_m.get_xscale() == "log" and ax_p.get_xlabel() == "frequency (Hz)"
+    H, s_abs, s_ph = lptv.freqresp_band(res, [10.0])
+    assert 0 < s_abs[0] < 0.01 * abs(H[0])
+    src = write_csv(tmp_path / "r.csv", u.ravel(), y.ravel())
+    assert run_cli(capsys, src, "--na", 2, "--nb", 0, "--fs", FS, "--period", T0, "--out", tmp_path / "o")[0] == 0
+    page = (tmp_path / "o" / "report.html").read_text()
+    assert page.index("Verdict:") < page.index('alt="bode.png"') < page.index('alt="compare.png"') \
+        < page.index('alt="normalized_residue.png"')
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert {r["name"] for r in s["parameters"]} >= {"a0.re0", "a1.re0", "b0.re0"}
+    assert s["lti"]["poles"][0]["wn"] == pytest.approx(10.0, rel=1e-3)
+
+
+# ------------------------------------------------------------------------------ 7. the command
+
+def test_command_without_arguments_prints_help_and_version(capsys):
+    assert cli.main([]) == 0
+    assert "usage: lptv" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as e:
+        cli.main(["--version"])
+    assert e.value.code == 0 and capsys.readouterr().out.strip() == f"lptv {lptv.__version__}"

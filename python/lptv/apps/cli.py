@@ -31,6 +31,9 @@ def _demo_parser(sub):
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         prog="lptv", description="lptv: identification of linear periodically time-varying systems")
+    from lptv import __version__
+
+    parser.add_argument("--version", action="version", version=f"lptv {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     _demo_parser(sub)
     from lptv.apps import fileid
@@ -39,6 +42,9 @@ def main(argv=None) -> int:
     from lptv.apps import montecarlo
 
     montecarlo.add_parser(sub)
+    if not (sys.argv[1:] if argv is None else argv):
+        parser.print_help()
+        return 0
     args = parser.parse_args(argv)
     if args.command == "demo":
         if args.monte_carlo < 0:

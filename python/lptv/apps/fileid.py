@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import (NumericalError, check_record, frozen_poles, frozen_zeros, identify, lti_table,
+from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_zeros, identify, lti_table,
                   parameter_table, plots, read_measurements, simulate)
 from lptv.apps.report import Report, write_json
 from lptv import METHODS
@@ -304,7 +304,22 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
         f"{summary['kb']} on the b_m ({res.n_free_parameters} free parameters) identified by "
         f"{res.method.upper()} from {P} periods of {N} samples in {src}, on {rows.size} lines "
         f"({rows.min()} to {rows.max()}).")
-    rep.preformatted(res.summary())
+    rep.paragraph("Verdict: " + res.verdict + ".")
+    var = "y[t+n]" if model.discrete else "d^n y/dt^n"
+    rep.preformatted(f"model: sum_n a_n(t) {var} = sum_m b_m(t) {var.replace('y', 'u').replace('n', 'm')}, "
+                     f"n = 0..{model.na}, m = 0..{model.nb}, a_n(t) = sum_k a_n,k exp(j k w0 t)\n"
+                     + res.summary())
+    try:
+        rep.figure(plots.bode(res), "bode.png",
+                   "Measured frequency response Y/U on the excited lines (+-2 standard deviations from the "
+                   "periods) and the model's, with its 95 % band from the parameter covariance.")
+        cmp = compare(res, meas.u, meas.y)
+        rep.figure(plots.compare(cmp).figure, "compare.png",
+                   f"Measured output (mean of the periods) and the model's output simulated from the measured "
+                   f"input over one period: fit {cmp['fit']:.1f} % = 100 (1 - ||y - yhat|| / ||y - mean y||).")
+        summary["fit_percent"] = cmp["fit"]
+    except (ValueError, NumericalError, np.linalg.LinAlgError):
+        pass
     gap = summary["prediction_error_vs_noise_db"]
     rep.table(["quantity", "value"], [
         ["file", f"{src} ({meas.format})"],
