@@ -28,12 +28,20 @@ def _demo_parser(sub):
     return p
 
 
+def _version() -> str:
+    """The installed distribution's version (the package metadata, as pip reports it)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("lptv")
+    except PackageNotFoundError:
+        return "(not installed: running from a source tree)"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         prog="lptv", description="lptv: identification of linear periodically time-varying systems")
-    from lptv import __version__
-
-    parser.add_argument("--version", action="version", version=f"lptv {__version__}")
+    parser.add_argument("--version", action="version", version=f"lptv {_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     _demo_parser(sub)
     from lptv.apps import fileid
