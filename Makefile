@@ -18,12 +18,12 @@ PREFIX := $(CURDIR)/$(BUILDROOT)/install
 APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2
 APT_BENCH := libsundials-dev
 # Python tools and test dependencies, pinned (the package's own runtime
-# dependencies are in pyproject.toml; the last line is its "batch" extra).
+# dependencies are in pyproject.toml; the last line is its "batch" extra and python-control).
 PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
 	numpy==2.4.6 scipy==1.17.1 pytest==9.2.0 hypothesis==6.170.15 matplotlib==3.11.2 \
 	scikit-sundae==1.2.0 h5py==3.16.0 pybind11-stubgen==3.0.0 \
 	dask==2026.8.0 distributed==2026.8.0 pandas==3.1.1 tqdm==4.70.1 \
-	threadpoolctl==3.8.0 pyarrow==26.0.1
+	threadpoolctl==3.8.0 pyarrow==26.0.1 control==0.10.2
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

@@ -25,8 +25,9 @@ from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
 from .floquet import FloquetResult, floquet
 from .selection import SelectionResult, select
-from .measurements import Measurements, read_measurements
+from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
 from .model import Model
+from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import Multisine, multisine, spectrum, time_signal
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
@@ -38,5 +39,6 @@ __all__ = [
     "IdentificationResult", "Model", "MonteCarloResult", "Multisine", "NumericalError", "SimulationResult", "TruncationWarning",
     "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
     "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",
-    "select", "SelectionResult", "simulate", "spectrum", "time_signal",
+    "select", "SelectionResult", "simulate", "spectrum", "time_signal", "check_record", "RecordCheck", "RecordWarning",
+    "lti_table", "parameter_table", "compare", "freqresp_band",
 ]

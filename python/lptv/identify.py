@@ -4,6 +4,7 @@ from __future__ import annotations
 import re
 import warnings
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -109,24 +110,138 @@ class IdentificationResult:
         lo, hi = self.fraction_band
         return lo <= self.fraction_above_0db <= hi
 
+    # -- the verdict --------------------------------------------------------------
+    @cached_property
+    def verdict_lines(self) -> np.ndarray:
+        """The rows the verdict judges: the fit rows at the excited lines (and within +-K of them
+        for an LPTV model); all fit rows when no line stands above the input noise."""
+        if self.data is None:
+            return self.lines
+        K = max(self.model.ka, self.model.kb)
+        try:
+            ex = excited_rows(self.data, K)
+        except ValueError:
+            return self.lines
+        sel = self.lines[np.isin(self.lines, ex)]
+        return sel if sel.size else self.lines
+
+    @cached_property
+    def _verdict_stats(self):
+        mask = np.isin(self.lines, self.verdict_lines)
+        r = self.normalized_residue[mask]
+        n = int(mask.sum())
+        frac = float(np.mean(r > 1.0)) if n else float("nan")
+        P = self.data.periods if self.data is not None else 0
+        n_free = int(round(self.n_free_parameters * n / max(self.lines.size, 1)))
+        try:
+            expected, band = _core.expected_fraction_above_0db(n, n_free, P)
+        except Exception:
+            expected, band = self.fraction_expected, self.fraction_band
+        return frac, float(expected), tuple(band)
+
+    @property
+    def verdict_fraction(self) -> float:
+        """Fraction of normalised residues above 0 dB on :attr:`verdict_lines`."""
+        return self._verdict_stats[0]
+
+    @property
+    def verdict_band(self) -> Tuple[float, float]:
+        """The predicted band of :attr:`verdict_fraction` (3 binomial standard deviations)."""
+        return self._verdict_stats[2]
+
+    @property
+    def cost_limit(self) -> Optional[float]:
+        """WGTLS, SML: the cost above which the model is rejected. A model the noise explains has a
+        cost near (P-1)/(P-2) (the mean of F(2, 2(P-1)) / 2 ... per row, sample variances); the limit
+        is 3 times that (10 for P = 2, 3 for known variances). None for the other methods, whose
+        cost is not normalised by the noise."""
+        if self.method not in ("wgtls", "sml") or self.noise_free:
+            return None
+        P = self.data.periods if self.data is not None else 0
+        if P == 0:
+            return 3.0
+        return 10.0 if P == 2 else 3.0 * (P - 1) / (P - 2)
+
+    @cached_property
+    def prediction_error_db(self) -> Optional[float]:
+        """Mean power of Y - Y_model (the model's output from the measured mean input) over the
+        variance of the mean output, on :attr:`verdict_lines`, in dB (about 0 dB for a model the
+        noise explains). None without data or where it cannot be computed."""
+        if self.data is None:
+            return None
+        from .fds import simulate
+
+        rows = self.verdict_lines
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                Yp = np.asarray(simulate(self.model, self.data.U))
+        except Exception:
+            return None
+        if Yp.shape != self.data.Y.shape:
+            return None
+        err = float(np.mean(np.abs(self.data.Y[rows] - Yp[rows]) ** 2))
+        noise = float(np.mean(self.data.varY[rows]))
+        if not (noise > 0 and err > 0):
+            return None
+        return float(10 * np.log10(err / noise))
+
+    PREDICTION_LIMIT_DB = 10.0
+    """A prediction error this far above the output noise (dB) rejects the model."""
+
+    @property
+    def model_errors(self) -> Tuple[str, ...]:
+        """The signs of a model error, each as a sentence (empty when none): residues outside the
+        predicted band on the excited lines, a cost far above 1, a prediction error far above the
+        noise. Any one rejects the model, whatever the fraction on all rows says."""
+        out = []
+        lo, hi = self.verdict_band
+        if not lo <= self.verdict_fraction <= hi:
+            out.append(f"{100 * self.verdict_fraction:.1f} % of the normalised residues on the "
+                       f"{self.verdict_lines.size} excited lines are above 0 dB, outside the predicted "
+                       f"{100 * lo:.1f}-{100 * hi:.1f} %")
+        lim = self.cost_limit
+        if lim is not None and self.cost > lim:
+            out.append(f"the cost {self.cost:.3g} is far above its noise level (limit {lim:.3g})")
+        gap = self.prediction_error_db
+        if gap is not None and gap > self.PREDICTION_LIMIT_DB:
+            out.append(f"the model's output misses the measured output by {gap:.1f} dB above the noise")
+        return tuple(out)
+
+    @property
+    def model_ok(self) -> bool:
+        """No sign of a model error (:attr:`model_errors` is empty)."""
+        return not self.model_errors
+
+    @property
+    def verdict(self) -> str:
+        """One sentence: is the model consistent with the noise, and if not, why."""
+        if self.model_ok:
+            return ("the model is consistent with the noise: the fit shows no sign of modelling errors "
+                    f"(on the {self.verdict_lines.size} excited lines)")
+        return "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+
+    def parameters(self, level: float = 0.95):
+        """The parameter table: see :func:`lptv.parameter_table`."""
+        from .parameters import parameter_table
+
+        return parameter_table(self, level)
+
     def summary(self) -> str:
         lo, hi = self.fraction_band
-        verdict = "consistent with the noise" if self.residue_ok else "OUTSIDE the predicted band: model errors?"
+        verdict = "in the predicted band" if self.residue_ok else "OUTSIDE the predicted band"
         lines = [
             f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} lines",
             f"iterations {self.iterations}, converged {self.converged}, cost {self.cost:.4g}",
             f"normalised residue above 0 dB: {100 * self.fraction_above_0db:.1f} % "
             f"(expected {100 * self.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %): {verdict}",
         ]
-        std = self.parameter_std
-        lines.append("parameters" + (" (+- one standard deviation)" if std is not None else "") + ":")
-        for i, name in enumerate(self.eta_names):
-            if std is None:
-                lines.append(f"  {name:10s} {self.eta[i]: .6g}")
-            elif std[i] == 0.0:
-                lines.append(f"  {name:10s} {self.eta[i]: .6g}  (normalised)")
-            else:
-                lines.append(f"  {name:10s} {self.eta[i]: .6g} +- {std[i]:.3g}")
+        from .parameters import format_parameter_table
+
+        lines.append("parameters" + (" (no covariance with this method)" if self.covariance is None else "")
+                     + ":")
+        lines.append(format_parameter_table(self))
+        lines.append(f"verdict: {self.verdict}")
         lines += [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
@@ -193,6 +308,35 @@ def _rows(lines):
     return [int(r) for r in rows]
 
 
+_DEFAULT_LINES = "excited"  # what lines=None means: the usable lines K+1..Lmax-K
+
+
+def excited_rows(data: FrequencyData, K: int = 0, ratio: float = 100.0) -> np.ndarray:
+    """The lines the input excites (power above ``ratio`` times its noise variance) and, for
+    K > 0, the lines within +-K of them, restricted to the usable rows K+1 .. Lmax-K.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.identify import excited_rows
+    >>> ms = lptv.multisine([3, 5], 64, seed=0)
+    >>> rng = np.random.default_rng(0)
+    >>> u = ms.periods(4) + 1e-3 * rng.standard_normal((4, 64))
+    >>> d = lptv.FrequencyData.from_periods(u, u, w0=1.0)
+    >>> excited_rows(d).tolist(), excited_rows(d, K=1).tolist()
+    ([3, 5], [2, 3, 4, 5, 6])
+    """
+    ex = np.asarray(_core.excited_lines(data._cpp, float(ratio)), dtype=int)
+    if ex.size == 0:
+        raise ValueError("lines='excited': no line of the input stands above its noise; pass lines explicitly")
+    K = int(K)
+    rows = np.unique((ex[:, None] + np.arange(-K, K + 1)[None, :]).ravel())
+    rows = rows[(rows >= K + 1) & (rows <= data.max_line - K)]
+    if rows.size == 0:
+        raise ValueError(f"lines='excited': no excited line lies within the usable rows {K + 1}..{data.max_line - K}")
+    return rows
+
+
 def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
              kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
              lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
@@ -212,8 +356,14 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         Fundamental of the period in rad/s (not needed with FrequencyData).
     ts : float, optional
         Sample period of a discrete-time model.
-    lines : sequence of int, optional
-        The rows (lines) of the fit. Default: K+1 .. Lmax-K, K the largest harmonic count.
+    lines : sequence of int or 'excited', optional
+        The rows (lines) of the fit. Default (None): all usable lines K+1 .. Lmax-K, K the
+        largest harmonic count; kept as the library's default so that existing scripts give the
+        same numbers. ``'excited'``: the lines the input excites (power 100 times above its
+        noise) and, for an LPTV model, the lines within +-K of them (:func:`excited_rows`);
+        this is what ``lptv identify FILE`` uses by default. Whatever the rows, the verdict
+        (:attr:`IdentificationResult.verdict`) judges the residues on the excited lines, so that
+        lines holding only noise do not dilute a model error.
     method : {'ls', 'tls', 'gtls', 'wgtls', 'sml'}
         'wgtls' is the paper's weighted GTLS; 'sml' minimises the exact likelihood of the
         residue (METHOD.md eq. 17, rows correlated through shared lines) from the WGTLS
@@ -254,14 +404,21 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
+    if isinstance(lines, str):
+        if lines != "excited":
+            raise ValueError(f"lines must be a sequence of integers or 'excited', got {lines!r}")
+        lines = excited_rows(data, max(ka_l + kb_l))
     rows = [] if lines is None else _rows(lines)
     r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter), rows=rows)
     for msg in r.warnings:
         unident = r.nearly_unidentifiable and "unidentifiable" in msg
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
     cov = r.covariance
+    model = Model._from_core(r.model)
+    if cov is not None:
+        model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
-        model=Model._from_core(r.model), method=method, lines=np.asarray(r.rows), theta=np.asarray(r.theta),
+        model=model, method=method, lines=np.asarray(r.rows), theta=np.asarray(r.theta),
         eta=np.asarray(r.eta), n_free_parameters=r.n_free, iterations=r.iterations, converged=r.converged,
         cost=r.cost, cost_history=np.asarray(r.cost_history), singular_values=np.asarray(r.singular_values),
         residue=np.asarray(r.residue), residue_variance=np.asarray(r.residue_variance),

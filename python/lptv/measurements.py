@@ -19,9 +19,10 @@ from __future__ import annotations
 
 import csv
 import io
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from typing import Optional, Tuple
 
 import numpy as np
 
@@ -46,14 +47,56 @@ class Measurements:
     y: np.ndarray
     w0: Optional[float]
     format: str
+    fs: Optional[float] = None
+    """The sampling frequency (Hz) when it was given; None otherwise."""
+    trimmed: int = 0
+    """Samples dropped at the start of a long record to keep whole periods (``trim=True``)."""
+    skipped: int = 0
+    """Whole periods dropped at the start (``skip_periods``)."""
 
 
 # ------------------------------------------------------------------------------ reading
 
-def read_measurements(path, periods: Optional[int] = None) -> Measurements:
+def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float] = None,
+                      dt: Optional[float] = None, period: Optional[float] = None,
+                      trim: bool = False, skip_periods: int = 0) -> Measurements:
     """Read u, y (shape (P, N)) and an optional w0 from a CSV, NPZ or MATLAB file.
 
+    Parameters
+    ----------
+    path : str or Path
+    periods : int, optional
+        How many periods a record stored as one long vector holds (CSV, vectors in NPZ/MAT).
+    fs, dt : float, optional
+        The sampling frequency in Hz, or the sampling time ``dt = 1 / fs`` in s (the name
+        python-control uses). This is how the data were recorded; it does not make the model
+        discrete. With the period (``period`` or the file's ``w0``) it gives the samples per
+        period ``N = fs * period``, which must be an integer: a long record is then split into
+        whole periods (``periods`` is not needed, and is checked if given), and a (P, N) array
+        must have that N.
+    period : float, optional
+        The period in s (used with ``fs``/``dt``; else the file's ``w0`` gives it).
+    trim : bool
+        A long record that does not hold a whole number of periods has its first samples
+        dropped (the record's end is the closest to steady state); without ``trim`` it is an
+        error that says how many samples to drop.
+    skip_periods : int
+        Drop this many whole periods at the start (a start-up transient).
+
     Raises :class:`FileError` with a message naming the problem (not the file).
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os, lptv
+    >>> d = tempfile.mkdtemp(); path = os.path.join(d, "long.npz")
+    >>> np.savez(path, u=np.arange(1050.0), y=np.arange(1050.0))    # 10.5 periods of 100 samples
+    >>> lptv.read_measurements(path, fs=100.0, period=1.0)
+    Traceback (most recent call last):
+    ...
+    lptv.measurements.FileError: variable 'u' has 1050 samples, 10.5 periods of 100 (fs 100 Hz x period 1 s): drop 50 samples to keep 10 whole periods (or trim=True / --trim)
+    >>> m = lptv.read_measurements(path, fs=100.0, period=1.0, trim=True, skip_periods=1)
+    >>> m.u.shape, m.trimmed, m.skipped
+    ((9, 100), 50, 1)
     """
     path = Path(path)
     fmt = FORMATS.get(path.suffix.lower())
@@ -65,24 +108,104 @@ def read_measurements(path, periods: Optional[int] = None) -> Measurements:
         raise FileError("is a directory, not a measurement file")
     if periods is not None and periods < 1:
         raise FileError(f"--periods must be a positive integer, got {periods}")
+    fs = _sampling(fs, dt)
+    if period is not None and not (np.isfinite(period) and period > 0):
+        raise FileError(f"--period must be a positive number, got {period!r}")
+    skip_periods = int(skip_periods)
+    if skip_periods < 0:
+        raise FileError(f"--skip-periods must be >= 0, got {skip_periods}")
+    split = _Split(periods, fs, period, trim)
     if fmt == "CSV":
-        u, y, w0 = _read_csv(path, periods)
+        u, y, w0 = _read_csv(path, split)
     elif fmt == "NPZ":
-        u, y, w0 = _read_npz(path, periods)
+        u, y, w0 = _read_npz(path, split)
     else:
-        u, y, w0, fmt = _read_mat(path, periods)
+        u, y, w0, fmt = _read_mat(path, split)
+    if fs is not None and split.period is None:
+        raise FileError("--fs needs the period: give --period (s) or --w0 (rad/s), or store w0 in the file")
     if u.shape != y.shape:
         raise FileError(f"u and y differ in shape: u is {_shape(u)} and y is {_shape(y)} (periods x samples)")
     if u.shape[0] < 2:
         raise FileError("the record holds only 1 period; the noise model needs at least 2")
-    return Measurements(u=u, y=y, w0=w0, format=fmt)
+    if skip_periods:
+        if u.shape[0] - skip_periods < 2:
+            raise FileError(f"--skip-periods {skip_periods} leaves {u.shape[0] - skip_periods} of "
+                            f"{u.shape[0]} periods; the noise model needs at least 2")
+        u, y = u[skip_periods:], y[skip_periods:]
+    return Measurements(u=u, y=y, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods)
+
+
+def _sampling(fs, dt):
+    """The sampling frequency from fs (Hz) or dt (s), or None."""
+    if fs is not None and dt is not None:
+        raise FileError("give the sampling frequency --fs or the sampling time --dt, not both")
+    for name, v in (("--fs", fs), ("--dt", dt)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise FileError(f"{name} must be a positive number, got {v!r}")
+    return fs if dt is None else 1.0 / dt
+
+
+def samples_per_period(fs: float, period: float, what: str = "fs x period") -> int:
+    """``N = fs * period`` as an integer, or :class:`FileError` when it is not one.
+
+    >>> from lptv.measurements import samples_per_period
+    >>> samples_per_period(100.0, 10.0)
+    1000
+    """
+    n = fs * period
+    N = int(round(n))
+    if N < 1 or abs(n - N) > 1e-6 * max(n, 1.0):
+        raise FileError(f"{what} gives {n:.8g} samples per period, not a whole number: "
+                        "check the sampling frequency and the period")
+    return N
+
+
+class _Split:
+    """How a long record becomes periods: by the stated count, by fs and the period, or both."""
+
+    def __init__(self, periods, fs, period, trim):
+        self.periods, self.fs, self.period, self.trim = periods, fs, period, bool(trim)
+        self.trimmed = 0
+
+    def n(self):
+        return None if self.fs is None or self.period is None else samples_per_period(
+            self.fs, self.period, f"fs {self.fs:g} Hz x period {self.period:g} s")
+
+    def vector(self, what, v):
+        N = self.n()
+        if N is None:
+            if self.periods is None:
+                return None
+            return _split_periods(what, v, self.periods)
+        P, r = divmod(v.size, N)
+        desc = f"fs {self.fs:g} Hz x period {self.period:g} s"
+        if P < 1:
+            raise FileError(f"{what} has {v.size} samples, less than one period of {N} ({desc})")
+        if self.periods is not None and v.size != self.periods * N:
+            raise FileError(f"{what} has {v.size} samples = {v.size / N:.6g} periods of {N} ({desc}), "
+                            f"but --periods says {self.periods} ({self.periods * N} samples)")
+        if r:
+            if not self.trim:
+                raise FileError(f"{what} has {v.size} samples, {v.size / N:.6g} periods of {N} ({desc}): "
+                                f"drop {r} samples to keep {P} whole periods (or trim=True / --trim)")
+            self.trimmed = r
+            v = v[r:]
+        return v.reshape(P, N)
+
+    def check_shape(self, name, a):
+        N = self.n()
+        if N is not None and a.shape[1] != N:
+            raise FileError(f"variable '{name}' has {a.shape[1]} samples per period, but fs {self.fs:g} Hz x "
+                            f"period {self.period:g} s gives {N}: the sampling frequency, the period "
+                            "or the record is wrong")
+        return a
 
 
 def _shape(a):
     return " x ".join(str(n) for n in a.shape)
 
 
-def _read_csv(path, periods):
+def _read_csv(path, split):
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
@@ -125,11 +248,11 @@ def _read_csv(path, periods):
         bad = np.flatnonzero(~np.isfinite(v))
         if bad.size:
             raise FileError(f"line {line_of[bad[0]]}: column '{name}' is NaN or inf")
-    if periods is None:
+    if split.periods is None and split.n() is None:
         raise FileError(f"--periods is required for a CSV record (how many periods its "
-                        f"{len(line_of)} samples hold)")
-    return (_split_periods("column 'u'", np.array(values["u"]), periods),
-            _split_periods("column 'y'", np.array(values["y"]), periods), None)
+                        f"{len(line_of)} samples hold), or --fs with --period")
+    return (split.vector("column 'u'", np.array(values["u"])),
+            split.vector("column 'y'", np.array(values["y"])), None)
 
 
 def _delimiter(text):
@@ -153,8 +276,9 @@ def _split_periods(what, v, periods):
     return v.reshape(periods, -1)
 
 
-def _as_periods(name, a, periods):
-    """A (P, N) float array from a file variable; vectors are split with --periods."""
+def _as_periods(name, a, split):
+    """A (P, N) float array from a file variable; vectors are split with --periods or fs."""
+    periods = split.periods
     what = f"variable '{name}'"
     a = np.asarray(a)
     if a.dtype.kind == "c":
@@ -167,12 +291,15 @@ def _as_periods(name, a, periods):
         raise FileError(f"{what} has {a.ndim} dimensions ({_shape(a)}); expected periods x samples")
     a = a.astype(float)
     if a.ndim < 2 or 1 in a.shape:
-        if periods is None:
+        v = split.vector(what, a.ravel())
+        if v is None:
             raise FileError(f"{what} is a vector of {a.size} samples: give --periods, "
-                            "the number of periods it holds")
-        a = _split_periods(what, a.ravel(), periods)
-    elif periods is not None and a.shape[0] != periods:
-        raise FileError(f"{what} holds {a.shape[0]} periods ({_shape(a)}) but --periods says {periods}")
+                            "the number of periods it holds (or --fs with the period)")
+        a = v
+    else:
+        if periods is not None and a.shape[0] != periods:
+            raise FileError(f"{what} holds {a.shape[0]} periods ({_shape(a)}) but --periods says {periods}")
+        a = split.check_shape(name, a)
     bad = np.argwhere(~np.isfinite(a))
     if bad.size:
         p, n = bad[0] + 1
@@ -240,8 +367,14 @@ def _u_y_w0(arrays, names, periods, kind):
     for name in ("u", "y"):
         if name not in arrays:
             raise FileError(f"{kind} '{name}' is missing (the file has {', '.join(names) or 'none'})")
-    return (_as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods),
-            _file_w0(arrays.get("w0")))
+    w0 = _file_w0(arrays.get("w0"))
+    if periods.fs is not None and w0 is not None:
+        if periods.period is None:
+            periods.period = 2 * np.pi / w0
+        elif not np.isclose(2 * np.pi / w0, periods.period, rtol=1e-9, atol=0):
+            raise FileError(f"the period {periods.period:.10g} s disagrees with the file's w0 = {w0:.10g} "
+                            f"rad/s (period {2 * np.pi / w0:.10g} s)")
+    return _as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods), w0
 
 
 def _h5_variable(f, name):
@@ -259,3 +392,103 @@ def _h5_variable(f, name):
         raise FileError(f"variable '{name}' is complex; a measured time signal is real")
     # MATLAB writes column-major arrays, so HDF5 sees the P x N variable as N x P.
     return np.asarray(obj[()]).T
+
+
+# ------------------------------------------------------------------------------ checks
+
+class RecordWarning(UserWarning):
+    """The record does not look like steady-state periods (a transient, or the wrong period)."""
+
+
+@dataclass(frozen=True)
+class RecordCheck:
+    """What :func:`check_record` found in P periods of u and y."""
+
+    transient_ratio: float
+    """Power of (first period - mean of the others) over what the noise explains (about 1
+    in steady state; inf where the others are noise-free and the first differs); nan for P < 3."""
+    transient_threshold: float
+    """The ratio above which the first period is reported as a transient."""
+    input_spread: float
+    """Mean variance of the input over the periods relative to the power of its mean period: small
+    (the input noise-to-signal ratio) for a periodic input cut at its period, about 1 or more for
+    a record cut at the wrong length."""
+    messages: Tuple[str, ...]
+
+    @property
+    def ok(self) -> bool:
+        return not self.messages
+
+
+def _transient_ratio(x):
+    P, N = x.shape
+    rest = x[1:]
+    d = x[0] - rest.mean(axis=0)
+    s2 = rest.var(axis=0, ddof=1).mean()
+    num = float(np.mean(d ** 2))
+    if s2 <= 0:
+        return np.inf if num > 1e-24 * max(float(np.mean(x ** 2)), 1e-300) else 1.0
+    return num / (s2 * (1.0 + 1.0 / (P - 1)))
+
+
+def check_record(u, y, *, warn: bool = True, spread_limit: float = 0.1) -> RecordCheck:
+    """Look for a start-up transient and for periods cut at the wrong length.
+
+    The transient check compares the first period with the mean of the others, relative to the
+    noise the other periods show: ``r = mean((x_1 - mean_{p>1} x_p)^2) / (s^2 (1 + 1/(P-1)))``
+    with ``s^2`` the sample variance over periods 2..P, for the input and the output (the larger
+    is reported). In steady state r is about 1 with standard deviation about
+    ``sqrt(2 / N + 2 / (N (P - 2)))`` (white noise); a first period above 1 + 6 such deviations (and
+    above 1.5) is reported with the advice to drop it (``skip_periods=1`` / ``--skip-periods 1``).
+    It needs P >= 3.
+
+    The period check: a periodic input (a generator's multisine) cut at its period repeats up to
+    its noise; ``input_spread`` (the mean variance over the periods over the power of the mean
+    period) above ``spread_limit`` says the record is not cut into its periods (wrong count,
+    period or sampling frequency).
+
+    Parameters
+    ----------
+    u, y : array_like, shape (P, N)
+    warn : bool
+        Also issue each message as a :class:`RecordWarning`.
+    spread_limit : float
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> rng = np.random.default_rng(0)
+    >>> x = np.tile(np.sin(2 * np.pi * np.arange(100) / 100), (6, 1))
+    >>> y = x + 0.01 * rng.standard_normal(x.shape)
+    >>> y[0] += 0.2 * np.exp(-np.arange(100) / 10)              # a decaying start-up transient
+    >>> c = lptv.check_record(x, y, warn=False)
+    >>> c.ok, c.transient_ratio > 10
+    (False, True)
+    >>> "skip_periods=1" in c.messages[0]
+    True
+    """
+    from .data import _periods_array
+
+    u, y = _periods_array(u, "u"), _periods_array(y, "y")
+    if u.shape != y.shape:
+        raise ValueError(f"u and y must have the same shape (P, N), got {u.shape} and {y.shape}")
+    P, N = u.shape
+    msgs = []
+    ratio, limit = np.nan, np.nan
+    if P >= 3:
+        ratio = max(_transient_ratio(u), _transient_ratio(y))
+        limit = max(1.0 + 6.0 * np.sqrt(2.0 / N + 2.0 / (N * (P - 2))), 1.5)
+        if ratio > limit:
+            msgs.append(f"the first period differs from the mean of the others by {ratio:.3g} times what "
+                        f"the noise explains (steady state: about 1): a start-up transient? Drop it with "
+                        f"skip_periods=1 (--skip-periods 1)")
+    mean_power = float(np.mean(u.mean(axis=0) ** 2))
+    spread = float(u.var(axis=0, ddof=1).mean() / mean_power) if mean_power > 0 else np.inf
+    if spread > spread_limit:
+        msgs.append(f"the input's periods differ by {100 * spread:.3g} % of its power: the record is not "
+                    f"{P} periods of {N} samples of a periodic input (check the number of periods, the "
+                    "period and the sampling frequency fs / --fs)")
+    if warn:
+        for m in msgs:
+            warnings.warn(m, RecordWarning, stacklevel=2)
+    return RecordCheck(float(ratio), float(limit), spread, tuple(msgs))

@@ -42,12 +42,142 @@ class Model:
     array([[1.1, 1. , 1. ]])
     """
 
+    covariance = None
+    """Covariance of the estimated real parameters (``eta_names``), set by :func:`lptv.identify`
+    for WGTLS and SML and kept by :meth:`save` / :meth:`load`; None otherwise."""
+    eta_names = ()
+    """Names of the parameters the covariance is about, e.g. 'a0.re1' (Re of harmonic 1 of a_0)."""
+
     def __init__(self, a, b, w0: float, ts: Optional[float] = None):
         a = as_complex_2d(a, "a")
         b = as_complex_2d(b, "b")
         if ts is None:
             ts = 0.0
         self._cpp = _core.Model(a, b, float(w0), float(ts))
+
+    @classmethod
+    def from_tf(cls, num, den, *, w0: float = 1.0, ts: Optional[float] = None) -> "Model":
+        """An LTI model from numerator and denominator in descending powers, as scipy.signal and
+        MATLAB write them: ``num = [b_nb, ..., b_0]``, ``den = [a_na, ..., a_0]`` (for a discrete
+        model, powers of the forward shift z). ``w0`` is the fundamental of the line grid the model
+        will be simulated on (any positive value for an LTI system).
+
+        Examples
+        --------
+        >>> import lptv
+        >>> m = lptv.Model.from_tf([1.0], [1.0, 4.0, 100.0])      # 1 / (s^2 + 4 s + 100)
+        >>> m.a[:, 0].real.tolist(), m.b[:, 0].real.tolist()
+        ([100.0, 4.0, 1.0], [1.0])
+        >>> m.to_tf()
+        (array([1.]), array([  1.,   4., 100.]))
+        """
+        num = as_real_1d(num, "num")
+        den = as_real_1d(den, "den")
+        for name, v in (("num", num), ("den", den)):
+            if v.size == 0 or v[0] == 0:
+                raise ValueError(f"{name} must be a non-empty coefficient list, highest power first, "
+                                 f"with a non-zero leading coefficient, got {v.tolist()}")
+        return cls(den[::-1].reshape(-1, 1), num[::-1].reshape(-1, 1), w0=w0, ts=ts)
+
+    def _check_t(self, t):
+        if t is None:
+            if not self.is_lti:
+                raise ValueError("t: this model is time-varying; give the time t (s) of the frozen system")
+            return 0.0
+        t = float(t)
+        if not np.isfinite(t):
+            raise ValueError(f"t must be a finite time (s), got {t!r}")
+        return t
+
+    def to_tf(self, t: Optional[float] = None):
+        """``(num, den)`` in descending powers (scipy.signal / MATLAB order) of the LTI model, or of
+        the frozen system at time ``t`` (s) of an LPTV model (:meth:`frozen`); real arrays.
+
+        A frozen system is the LTI system with the coefficients held at their values at t; it is
+        not the periodic system's response (use :meth:`freqresp` for that).
+        """
+        num, den = self.frozen(self._check_t(t))
+        return np.real(num).copy(), np.real(den).copy()
+
+    def to_lti(self, t: Optional[float] = None):
+        """A :class:`scipy.signal.lti` (continuous) or :class:`scipy.signal.dlti` (discrete, ``dt =
+        ts``) of the LTI model or of the frozen system at time ``t``.
+
+        Examples
+        --------
+        >>> import numpy as np, lptv
+        >>> m = lptv.Model.from_tf([1.0], [1.0, 4.0, 100.0])
+        >>> w, H = m.to_lti().freqresp([10.0])
+        >>> bool(np.allclose(H, m.freqresp([10.0]), rtol=1e-14))
+        True
+        """
+        import scipy.signal
+
+        num, den = self.to_tf(t)
+        if self.discrete:
+            return scipy.signal.dlti(num, den, dt=self.ts)
+        return scipy.signal.lti(num, den)
+
+    def to_control(self, t: Optional[float] = None):
+        """A python-control ``TransferFunction`` (``control.tf``; ``dt = ts`` in discrete time) of the
+        LTI model or of the frozen system at time ``t``. Needs the optional extra
+        ``pip install 'lptv[control]'``."""
+        try:
+            import control
+        except ImportError:
+            raise ImportError("Model.to_control needs python-control: pip install 'lptv[control]'") from None
+        num, den = self.to_tf(t)
+        return control.tf(num, den, self.ts) if self.discrete else control.tf(num, den)
+
+    def freqresp(self, w, *, branch: int = 0, harmonics: Optional[int] = None) -> np.ndarray:
+        """Frequency response at angular frequencies ``w`` (rad/s).
+
+        For an LTI model ``B(s) / A(s)`` at ``s = j w`` (``z = exp(j w ts)`` in discrete time). For
+        an LPTV model the harmonic transfer function's branch ``G_branch(w)``: an input exp(j w t)
+        gives the output ``sum_k G_k(w) exp(j (w + k w0) t)``; ``branch=0`` is the time-averaged
+        transfer function. It is computed by harmonic balance on ``2 harmonics + 1`` output
+        harmonics (default ``max(32, 8 (Ka + Kb))``), converged for a stable, well-behaved model.
+
+        Examples
+        --------
+        >>> import numpy as np, lptv
+        >>> m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)          # 1 / (s + 2)
+        >>> bool(np.isclose(m.freqresp([2.0])[0], 1 / (2j + 2)))
+        True
+        """
+        w = as_real_1d(w, "w")
+        branch = int(branch)
+        if self.is_lti:
+            if branch:
+                return np.zeros(w.size, complex)
+            x = np.exp(1j * w * self.ts) if self.discrete else 1j * w
+            num, den = self.to_tf()
+            return np.polyval(num, x) / np.polyval(den, x)
+        L = max(32, 8 * (self.ka + self.kb)) if harmonics is None else int(harmonics)
+        if abs(branch) > L:
+            raise ValueError(f"branch {branch} is beyond the {L} harmonics of the balance")
+        a, b, Ka, Kb = self.a, self.b, self.ka, self.kb
+        ks = np.arange(-L, L + 1)
+        out = np.empty(w.size, complex)
+        for i, wi in enumerate(w):
+            x = np.exp(1j * (wi + ks * self.w0) * self.ts) if self.discrete else 1j * (wi + ks * self.w0)
+            A = np.zeros((ks.size, ks.size), complex)
+            for n in range(self.na + 1):
+                pw = x ** n
+                for h in range(-Ka, Ka + 1):
+                    c = a[n, Ka + h]
+                    if c == 0:
+                        continue
+                    # row k, column j = k - h: a_{n,h} x_j^n
+                    idx = np.arange(max(0, h), min(ks.size, ks.size + h))
+                    A[idx, idx - h] += c * pw[idx - h]
+            rhs = np.zeros(ks.size, complex)
+            x0 = np.exp(1j * wi * self.ts) if self.discrete else 1j * wi
+            for m in range(self.nb + 1):
+                for h in range(-Kb, Kb + 1):
+                    rhs[L + h] += b[m, Kb + h] * x0 ** m
+            out[i] = np.linalg.solve(A, rhs)[L + branch]
+        return out
 
     @classmethod
     def _from_core(cls, cpp: "_core.Model") -> "Model":
@@ -111,6 +241,13 @@ class Model:
 
     # -- persistence -------------------------------------------------------------
     def to_dict(self) -> dict:
+        d = self._to_dict()
+        if self.covariance is not None:
+            d["eta_names"] = list(self.eta_names)
+            d["covariance"] = np.asarray(self.covariance).tolist()
+        return d
+
+    def _to_dict(self) -> dict:
         return {
             "format": "lptv.Model",
             "version": 1,
@@ -129,9 +266,17 @@ class Model:
         try:
             a = np.asarray(d["a_real"], float) + 1j * np.asarray(d["a_imag"], float)
             b = np.asarray(d["b_real"], float) + 1j * np.asarray(d["b_imag"], float)
-            return cls(a, b, w0=d["w0"], ts=d.get("ts"))
+            m = cls(a, b, w0=d["w0"], ts=d.get("ts"))
         except KeyError as e:
             raise ValueError(f"lptv.Model description lacks the field {e.args[0]!r}") from None
+        if d.get("covariance") is not None:
+            cov = np.asarray(d["covariance"], float)
+            names = tuple(str(n) for n in d.get("eta_names", ()))
+            if cov.shape != (len(names), len(names)):
+                raise ValueError(f"lptv.Model description: covariance of shape {cov.shape} does not match "
+                                 f"its {len(names)} eta_names")
+            m.covariance, m.eta_names = cov, names
+        return m
 
     def save(self, path) -> None:
         """Write the model as JSON (readable by :meth:`Model.load`)."""

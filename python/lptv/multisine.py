@@ -97,7 +97,18 @@ def spectrum(x) -> np.ndarray:
 def time_signal(X, n_samples: int) -> np.ndarray:
     """One period of the real signal whose one-sided spectrum is X (lines 0..L, L <= N/2).
 
-    ``X[0]`` (and ``X[N/2]`` for even N) must be real, as for a real signal.
+    ``X[0]`` must be real, as for a real signal. For even N the Nyquist line ``X[N/2]`` is made
+    real (its real part is kept): the samples of ``exp(j pi n)`` and ``cos(pi n)`` agree, so a
+    real signal sampled N times per period cannot carry its imaginary part, and a spectrum from
+    :func:`lptv.simulate` (a continuous-time model's response at the frequency N/2 w0) may well
+    have one. ``time_signal(simulate(model, U), N)`` thus works for every N.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> x = lptv.time_signal([0.0, 0.0, 1.0 + 1.0j], 4)      # Nyquist line of N = 4
+    >>> x.round(12).tolist()
+    [1.0, -1.0, 1.0, -1.0]
     """
     n_samples = as_int(n_samples, "n_samples", minimum=1)
     Xa, was_1d = as_spectrum(X, "X")
@@ -108,8 +119,9 @@ def time_signal(X, n_samples: int) -> np.ndarray:
         raise ValueError(f"X must have between 1 and {n_samples // 2 + 1} lines (0..n_samples//2) "
                          f"for n_samples = {n_samples}, got {Xa.size}")
     scale = max(np.abs(Xa).max(), 1e-300)
-    real_lines = [0] + ([n_samples // 2] if n_samples % 2 == 0 and Xa.size > n_samples // 2 else [])
-    for l in real_lines:
-        if abs(Xa[l].imag) > 1e-12 * scale:
-            raise ValueError(f"X: line {l} must be real for a real signal, got {Xa[l]}")
+    if abs(Xa[0].imag) > 1e-12 * scale:
+        raise ValueError(f"X: line 0 must be real for a real signal, got {Xa[0]}")
+    if n_samples % 2 == 0 and Xa.size > n_samples // 2:
+        Xa = Xa.copy()
+        Xa[n_samples // 2] = Xa[n_samples // 2].real
     return np.asarray(_core.time_signal(Xa, n_samples))

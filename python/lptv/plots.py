@@ -205,3 +205,72 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
     ax.legend(fontsize=7, ncol=2)
     ax.grid(True, which="both", alpha=0.3)
     return ax
+
+
+def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig=None):
+    """Bode plot of an identification: the measured FRF ``Y / U`` on the excited lines with +-2
+    standard deviations (from the periods' noise), the model's (time-averaged) frequency response
+    and its ``level`` band from the parameter covariance. Log-frequency axis in rad/s (or Hz).
+
+    Returns the figure (magnitude on top, phase below).
+    """
+    from .parameters import freqresp_band
+    from scipy.stats import norm
+
+    if fig is None:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(6.4, 5.6), layout="constrained")
+    ax_m, ax_p = fig.subplots(2, 1, sharex=True)
+    d, model = res.data, res.model
+    rows = np.asarray(res.verdict_lines)
+    U, Y = d.U[rows], d.Y[rows]
+    G = Y / U
+    varG = (d.varY[rows] + np.abs(G) ** 2 * d.varU[rows] - 2 * np.real(np.conj(G) * d.covYU[rows])) / np.abs(U) ** 2
+    sG = np.sqrt(np.maximum(varG, 0.0))
+    w_lines = rows * model.w0
+    scale = 1 / (2 * np.pi) if hz else 1.0
+    wmax = np.pi / model.ts if model.discrete else w_lines.max() * 1.5
+    w = np.logspace(np.log10(w_lines.min() / 1.5), np.log10(min(wmax, w_lines.max() * 1.5)), n_points)
+    H, s_abs, s_ph = freqresp_band(res, w)
+    z = norm.ppf(0.5 + level / 2)
+    x = w * scale
+    if s_abs is not None:
+        ax_m.fill_between(x, _db(np.maximum(np.abs(H) - z * s_abs, 1e-300)), _db(np.abs(H) + z * s_abs),
+                          color="C1", alpha=0.3, lw=0, label=f"model {100 * level:g} % band")
+        ax_p.fill_between(x, np.degrees(np.unwrap(np.angle(H)) - z * s_ph),
+                          np.degrees(np.unwrap(np.angle(H)) + z * s_ph), color="C1", alpha=0.3, lw=0)
+    ax_m.errorbar(w_lines * scale, _db(G), yerr=[_db(np.abs(G)) - _db(np.maximum(np.abs(G) - 2 * sG, 1e-300 + 0 * sG)),
+                                                   _db(np.abs(G) + 2 * sG) - _db(G)],
+                  fmt="o", ms=3.5, mfc="none", color="C0", elinewidth=0.8, label="measured Y/U (+-2 std)")
+    ax_m.plot(x, _db(H), "-", color="C1", lw=1.2, label="model")
+    ph_meas = np.degrees(np.angle(G))
+    ph_model = np.degrees(np.unwrap(np.angle(H)))
+    # put the measured phase on the model's branch
+    ph_at = np.interp(w_lines, w, ph_model)
+    ph_meas = ph_meas + 360 * np.round((ph_at - ph_meas) / 360)
+    ax_p.errorbar(w_lines * scale, ph_meas, yerr=2 * np.degrees(sG / np.abs(G)), fmt="o", ms=3.5, mfc="none",
+                  color="C0", elinewidth=0.8)
+    ax_p.plot(x, ph_model, "-", color="C1", lw=1.2)
+    for ax in (ax_m, ax_p):
+        ax.set_xscale("log")
+        ax.grid(True, which="both", alpha=0.3)
+    ax_m.set_ylabel("magnitude (dB)")
+    ax_p.set_ylabel("phase (deg)")
+    ax_p.set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
+    ax_m.legend(fontsize="small")
+    kind = "" if model.is_lti else " (time-averaged, branch G_0)"
+    ax_m.set_title(f"Bode plot{kind}: measured and identified")
+    return fig
+
+
+def compare(cmp, *, ax=None, unit: str = ""):
+    """Measured against simulated output over one period (a :func:`lptv.compare` result)."""
+    ax = _axes(ax)
+    ax.plot(cmp["t"], cmp["y"], "-", color="C0", lw=1.0, label="measured (mean of the periods)")
+    ax.plot(cmp["t"], cmp["y_model"], "--", color="C1", lw=1.2, label=f"model, fit {cmp['fit']:.1f} %")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("output" + (f" ({unit})" if unit else ""))
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax

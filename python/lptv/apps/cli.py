@@ -29,9 +29,20 @@ def _demo_parser(sub):
     return p
 
 
+def _version() -> str:
+    """The installed distribution's version (the package metadata, as pip reports it)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("lptv")
+    except PackageNotFoundError:
+        return "(not installed: running from a source tree)"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         prog="lptv", description="lptv: identification of linear periodically time-varying systems")
+    parser.add_argument("--version", action="version", version=f"lptv {_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     _demo_parser(sub)
     from lptv.apps import fileid
@@ -43,6 +54,9 @@ def main(argv=None) -> int:
     from lptv.apps import choose
 
     choose.add_parser(sub)
+    if not (sys.argv[1:] if argv is None else argv):
+        parser.print_help()
+        return 0
     args = parser.parse_args(argv)
     if args.command == "demo":
         if args.monte_carlo < 0:

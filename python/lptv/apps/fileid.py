@@ -33,16 +33,19 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import (NumericalError, frozen_poles, frozen_zeros, identify, plots, read_measurements,
-                  simulate)
+from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_zeros, identify, lti_table,
+                  parameter_table, plots, read_measurements, simulate)
 from lptv.apps.report import Report, write_json
 from lptv import METHODS
 from lptv.measurements import FileError
 
 # ------------------------------------------------------------------------------ options
 
-def parse_lines(text: str) -> np.ndarray:
-    """'1-243', '1-100,120-150' or '10,20,30' -> the line numbers, in the order given."""
+def parse_lines(text: str):
+    """'1-243', '1-100,120-150' or '10,20,30' -> the line numbers, in the order given;
+    'excited' -> 'excited' (the lines the input excites, +-K for an LPTV model)."""
+    if text.strip().lower() == "excited":
+        return "excited"
     out = []
     for tok in text.split(","):
         m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", tok)
@@ -105,6 +108,8 @@ def _fundamental(args, meas):
         if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
             raise FileError(f"{given} gives w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
         w0, given = meas.w0, "the file's w0"
+    if meas.fs is not None and w0 is None:
+        w0 = 2 * np.pi * meas.fs / meas.u.shape[1]
     if positive(args.ts, "--ts") is not None:
         n = meas.u.shape[1]
         w0_ts = 2 * np.pi / (n * args.ts)
@@ -144,9 +149,23 @@ def add_parser(sub):
     g = p.add_mutually_exclusive_group()
     g.add_argument("--w0", type=float, help="fundamental of the period (rad/s)")
     g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
-    p.add_argument("--ts", type=float, help="sample period: identify a discrete-time model")
+    s = p.add_mutually_exclusive_group()
+    s.add_argument("--fs", type=float, metavar="HZ",
+                   help="sampling frequency of the record (Hz); the model stays continuous-time. With the "
+                        "period it gives the samples per period and splits a long record into whole periods")
+    s.add_argument("--dt", type=float, metavar="S", help="sampling time of the record (s), 1 / fs")
+    p.add_argument("--discrete", action="store_true",
+                   help="identify a discrete-time model (in the shift z) with the sample period 1 / fs")
+    p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "
+                   "to state how the record was sampled for a continuous-time model use --fs or --dt")
     p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
-    p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150 (default: all usable)")
+    p.add_argument("--trim", action="store_true",
+                   help="with --fs: drop the first samples of a long record to keep whole periods")
+    p.add_argument("--skip-periods", type=int, default=0, metavar="K",
+                   help="drop the first K periods (a start-up transient)")
+    p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150, or 'excited' (the lines "
+                   "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
+                   "judges the excited lines")
     p.add_argument("--method", default="wgtls", choices=METHODS, help="estimator (default wgtls)")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
@@ -184,23 +203,41 @@ def run(args) -> int:
         if args.max_iter < 0:
             raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
         positive(args.tol, "--tol")
-        meas = read_measurements(src, args.periods)
+        period = None
+        if args.fs is not None or args.dt is not None:
+            period = positive(args.period, "--period")
+            if period is None and positive(args.w0, "--w0") is not None:
+                period = 2 * np.pi / args.w0
+        meas = read_measurements(src, args.periods, fs=args.fs, dt=args.dt, period=period,
+                                 trim=args.trim, skip_periods=args.skip_periods)
+        if args.discrete and args.ts is not None:
+            raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
+        if args.discrete and meas.fs is None:
+            raise FileError("--discrete needs the sampling frequency --fs (or --dt)")
+        ts = 1.0 / meas.fs if args.discrete else args.ts
+        if args.discrete:
+            args.ts = ts
         w0 = _fundamental(args, meas)
+        record = check_record(meas.u, meas.y, warn=False)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts,
+            res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
                            max_iter=args.max_iter)
             Y_pred = simulate(res.model, res.data.U)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
-    extra = [str(w.message) for w in caught if str(w.message) not in res.warnings]
+    extra = list(record.messages) + [str(w.message) for w in caught if str(w.message) not in res.warnings]
 
     P, N = meas.u.shape
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
     print(f"lptv identify: {src} ({meas.format}, {P} periods of {N} samples, w0 = {w0:.6g} rad/s"
-          + (f", ts = {args.ts:g} s" if args.ts else "") + f") -> {out}/")
+          + (f", fs = {meas.fs:g} Hz" if meas.fs else "")
+          + (f", discrete-time model with ts = {args.ts:g} s" if args.ts else ", continuous-time model")
+          + f") -> {out}/")
+    if meas.trimmed or meas.skipped:
+        print(f"dropped at the start: {meas.trimmed} samples (--trim), {meas.skipped} periods (--skip-periods)")
     print(res.summary())
     for msg in extra:
         print(f"warning: {msg}")
@@ -238,8 +275,23 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "fraction_above_0db": res.fraction_above_0db, "fraction_expected": res.fraction_expected,
         "fraction_band": list(res.fraction_band), "residue_ok": res.residue_ok,
         "prediction_error_vs_noise_db": _prediction_gap_db(res, Y_pred),
+        "fs": meas.fs, "trimmed_samples": meas.trimmed, "skipped_periods": meas.skipped,
+        "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
+        "n_verdict_lines": int(res.verdict_lines.size), "verdict_fraction_above_0db": res.verdict_fraction,
+        "verdict_band": list(res.verdict_band),
+        "parameters": parameter_table(res),
+        "lti": _json_lti(res),
         "warnings": list(res.warnings) + extra,
     }
+
+
+def _json_lti(res):
+    if not res.model.is_lti:
+        return None
+    t = lti_table(res)
+    for p in t["poles"]:
+        p["pole"] = [p["pole"].real, p["pole"].imag]
+    return t
 
 
 def _report(src, meas, res, Y_pred, summary) -> Report:
@@ -252,7 +304,22 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
         f"{summary['kb']} on the b_m ({res.n_free_parameters} free parameters) identified by "
         f"{res.method.upper()} from {P} periods of {N} samples in {src}, on {rows.size} lines "
         f"({rows.min()} to {rows.max()}).")
-    rep.preformatted(res.summary())
+    rep.paragraph("Verdict: " + res.verdict + ".")
+    var = "y[t+n]" if model.discrete else "d^n y/dt^n"
+    rep.preformatted(f"model: sum_n a_n(t) {var} = sum_m b_m(t) {var.replace('y', 'u').replace('n', 'm')}, "
+                     f"n = 0..{model.na}, m = 0..{model.nb}, a_n(t) = sum_k a_n,k exp(j k w0 t)\n"
+                     + res.summary())
+    try:
+        rep.figure(plots.bode(res), "bode.png",
+                   "Measured frequency response Y/U on the excited lines (+-2 standard deviations from the "
+                   "periods) and the model's, with its 95 % band from the parameter covariance.")
+        cmp = compare(res, meas.u, meas.y)
+        rep.figure(plots.compare(cmp).figure, "compare.png",
+                   f"Measured output (mean of the periods) and the model's output simulated from the measured "
+                   f"input over one period: fit {cmp['fit']:.1f} % = 100 (1 - ||y - yhat|| / ||y - mean y||).")
+        summary["fit_percent"] = cmp["fit"]
+    except (ValueError, NumericalError, np.linalg.LinAlgError):
+        pass
     gap = summary["prediction_error_vs_noise_db"]
     rep.table(["quantity", "value"], [
         ["file", f"{src} ({meas.format})"],
