@@ -1,0 +1,186 @@
+// The small-band LU kernel behind lptv::SmallBandLU (band_lu.hpp): Gaussian elimination with
+// partial pivoting of a complex band matrix with K sub- and K super-diagonals, written for
+// small K (2K+1 = 3..15 unrolled by a template parameter, one runtime-K instance above).
+//
+// A streams through a window of K+1 rows. Step k holds rows k..k+K of the row-permuted matrix,
+// each as its 2K+1 entries in columns k..k+2K (pivoting fills U up to column k+2K, and only the
+// row that enters at step k reaches that far). A row enters the window when it is first
+// needed, built by a row source straight into the window: the matrix is never stored, only its
+// factors. The right-hand sides of a row (for the FDS: B U and the conditioning check) enter
+// with it and are eliminated in the same step, so that the forward substitution is part of the
+// factorisation. The pivot search, the row swap and the choice of the first largest
+// |Re| + |Im| are those of LAPACK's zgbtf2, so the pivots equal zgbtrf's on the same matrix.
+//
+// Private to the library (namespace detail); the tests reach it through SmallBandLU.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include "lptv/band_lu.hpp"
+
+namespace lptv {
+namespace detail {
+
+using kcd = std::complex<double>;
+
+// a - l u, and l u, written out: GCC's std::complex product guards against NaN with a library
+// call on every product, which keeps the loops below from being unrolled into plain FMAs.
+inline kcd cmul(kcd a, kcd b) {
+  return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+}
+inline kcd cmsub(kcd a, kcd l, kcd u) {
+  return {a.real() - (l.real() * u.real() - l.imag() * u.imag()),
+          a.imag() - (l.real() * u.imag() + l.imag() * u.real())};
+}
+// 1 / p by Smith's method (no overflow of |p|^2).
+inline kcd crecip(kcd p) {
+  const double a = p.real(), b = p.imag();
+  if (std::abs(a) >= std::abs(b)) {
+    const double r = b / a, d = a + b * r;
+    return {1.0 / d, -r / d};
+  }
+  const double r = a / b, d = b + a * r;
+  return {r / d, -1.0 / d};
+}
+inline double cabs1(kcd z) { return std::abs(z.real()) + std::abs(z.imag()); }
+
+// The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} (stride 2K+1); the multipliers
+// of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
+struct BandFactors {
+  int n = 0, K = 0;
+  std::vector<kcd> U;
+  std::vector<kcd> L;  // empty when the factors are used for the right-hand sides given only
+  std::vector<std::uint8_t> piv;
+};
+
+// Thrown through the kernel as the column of the first exactly zero pivot (the caller names it).
+struct ZeroPivot {
+  int column;
+};
+
+// Factorises the n x n band matrix given by src, eliminating nz right-hand sides on the way.
+// Source:  void row(int r, int base, kcd* out): out[j] = A(r, base + j), j = 0..2K (zero
+//          outside the band and the matrix);  void rhs(int r, kcd* z): the nz right-hand sides
+//          of row r.
+// z: (n + 2K) x nz, row-major: rows 0..n-1 receive the forward-eliminated right-hand sides,
+// the 2K rows below are set to zero (back_substitute reads past the last row).
+template <int KT, class Source>
+void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_L, kcd* z) {
+  const int K = KT >= 0 ? KT : Krt;
+  const int W = 2 * K + 1;
+  f.n = n;
+  f.K = K;
+  f.U.resize(static_cast<size_t>(n) * W);
+  f.piv.resize(n);
+  if (keep_L) f.L.assign(static_cast<size_t>(n) * std::max(K, 1), kcd(0.0, 0.0));
+  else f.L.clear();
+  std::vector<kcd> win(static_cast<size_t>(K + 1) * W), zw(static_cast<size_t>(K + 1) * std::max(nz, 1));
+  int slot[KT >= 0 ? KT + 1 : 1];
+  std::vector<int> slot_rt(KT >= 0 ? 0 : K + 1);
+  int* sl = KT >= 0 ? slot : slot_rt.data();
+  for (int i = 0; i <= K; ++i) sl[i] = i;
+  auto wrow = [&](int s) { return &win[static_cast<size_t>(s) * W]; };
+  auto zrow = [&](int s) { return &zw[static_cast<size_t>(s) * nz]; };
+  // Rows 0..K-1 enter against columns 0..2K.
+  for (int r = 0; r < std::min(K, n); ++r) {
+    src.row(r, 0, wrow(sl[r]));
+    if (nz) src.rhs(r, zrow(sl[r]));
+  }
+  for (int k = 0; k < n; ++k) {
+    if (k + K < n) {
+      src.row(k + K, k, wrow(sl[K]));
+      if (nz) src.rhs(k + K, zrow(sl[K]));
+    }
+    const int m = std::min(K, n - 1 - k);  // rows below the pivot row in the window
+    int p = 0;
+    double best = cabs1(wrow(sl[0])[0]);
+    for (int i = 1; i <= m; ++i) {
+      const double v = cabs1(wrow(sl[i])[0]);
+      if (v > best) best = v, p = i;
+    }
+    if (best == 0.0) throw ZeroPivot{k};
+    std::swap(sl[0], sl[p]);
+    f.piv[k] = static_cast<std::uint8_t>(p);
+    const kcd* P = wrow(sl[0]);
+    kcd* Uk = &f.U[static_cast<size_t>(k) * W];
+    const kcd inv = crecip(P[0]);
+    Uk[0] = inv;
+    for (int j = 1; j < W; ++j) Uk[j] = P[j];
+    const kcd* zp = zrow(sl[0]);
+    kcd* zk = z + static_cast<size_t>(k) * nz;
+    for (int c = 0; c < nz; ++c) zk[c] = zp[c];
+    for (int i = 1; i <= m; ++i) {
+      kcd* R = wrow(sl[i]);
+      const kcd l = cmul(R[0], inv);
+      if (keep_L) f.L[static_cast<size_t>(k) * K + (i - 1)] = l;
+      // Eliminate column k and shift the row one column left (the window moves with k).
+      for (int j = 1; j < W; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
+      R[W - 1] = kcd(0.0, 0.0);
+      kcd* zr = zrow(sl[i]);
+      for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
+    }
+    // The pivot row leaves; its slot takes the row that enters at the next step.
+    const int out = sl[0];
+    for (int i = 0; i < K; ++i) sl[i] = sl[i + 1];
+    sl[K] = out;
+  }
+  std::fill(z + static_cast<size_t>(n) * nz, z + static_cast<size_t>(n + 2 * K) * nz, kcd(0.0, 0.0));
+}
+
+// z (rows 0..n-1 forward-eliminated, 2K zero rows below) := U^-1 z, in place.
+template <int KT>
+void back_substitute(const BandFactors& f, int nz, kcd* z) {
+  const int K = KT >= 0 ? KT : f.K;
+  const int W = 2 * K + 1;
+  for (int k = f.n - 1; k >= 0; --k) {
+    const kcd* Uk = &f.U[static_cast<size_t>(k) * W];
+    kcd* zk = z + static_cast<size_t>(k) * nz;
+    for (int c = 0; c < nz; ++c) {
+      kcd s = zk[c];
+      for (int j = 1; j < W; ++j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
+      zk[c] = cmul(s, Uk[0]);
+    }
+  }
+}
+
+// z (n + 2K rows, the last 2K zero) := L^-1 P z, in place, from the stored multipliers.
+template <int KT>
+void forward_substitute(const BandFactors& f, int nz, kcd* z) {
+  const int K = KT >= 0 ? KT : f.K;
+  for (int k = 0; k < f.n; ++k) {
+    kcd* zk = z + static_cast<size_t>(k) * nz;
+    const int p = f.piv[k];
+    if (p) std::swap_ranges(zk, zk + nz, zk + static_cast<size_t>(p) * nz);
+    const kcd* Lk = &f.L[static_cast<size_t>(k) * K];
+    for (int i = 1; i <= K; ++i) {
+      const kcd l = Lk[i - 1];
+      kcd* zi = zk + static_cast<size_t>(i) * nz;
+      for (int c = 0; c < nz; ++c) zi[c] = cmsub(zi[c], l, zk[c]);
+    }
+  }
+}
+
+// Calls f(std::integral_constant<int, K>) for K = 0..7, f(std::integral_constant<int, -1>)
+// (runtime K) above.
+template <class F>
+decltype(auto) dispatch_band(int K, F&& f) {
+  switch (K) {
+    case 0: return f(std::integral_constant<int, 0>());
+    case 1: return f(std::integral_constant<int, 1>());
+    case 2: return f(std::integral_constant<int, 2>());
+    case 3: return f(std::integral_constant<int, 3>());
+    case 4: return f(std::integral_constant<int, 4>());
+    case 5: return f(std::integral_constant<int, 5>());
+    case 6: return f(std::integral_constant<int, 6>());
+    case 7: return f(std::integral_constant<int, 7>());
+    default: return f(std::integral_constant<int, -1>());
+  }
+}
+
+}  // namespace detail
+}  // namespace lptv
