@@ -18,10 +18,17 @@
 #include <complex>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <new>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
 #include "lptv/band_lu.hpp"
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 namespace lptv {
 namespace detail {
@@ -41,19 +48,57 @@ inline kcd cmsub(kcd a, kcd l, kcd u) {
 inline kcd crecip(kcd p) {
   const double a = p.real(), b = p.imag();
   if (std::abs(a) >= std::abs(b)) {
-    const double r = b / a, d = a + b * r;
-    return {1.0 / d, -r / d};
+    const double r = b / a, id = 1.0 / (a + b * r);
+    return {id, -r * id};
   }
-  const double r = a / b, d = b + a * r;
-  return {r / d, -1.0 / d};
+  const double r = a / b, id = 1.0 / (b + a * r);
+  return {r * id, -id};
 }
 inline double cabs1(kcd z) { return std::abs(z.real()) + std::abs(z.imag()); }
 
 // The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} (stride 2K+1); the multipliers
 // of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
+// An array of complex numbers left uninitialised on allocation (std::vector would write zeros
+// over the factors first: one more pass over the largest array of the FDS).
+// Large arrays ask Linux for transparent huge pages: at 10^7 lines the first touches of 4 KiB
+// pages (a page fault each) took a fifth of the FDS's time (bench/RESULTS.md).
+class RawArray {
+ public:
+  void resize(size_t count) {
+    if (count > cap_) {
+      const size_t bytes = 2 * count * sizeof(double);
+      void* q = nullptr;
+#ifdef __linux__
+      constexpr size_t kHuge = size_t(2) << 20;
+      if (bytes >= 2 * kHuge) {
+        if (posix_memalign(&q, kHuge, (bytes + kHuge - 1) / kHuge * kHuge) != 0) q = nullptr;
+        if (q) madvise(q, (bytes + kHuge - 1) / kHuge * kHuge, MADV_HUGEPAGE);
+      }
+#endif
+      if (!q) q = std::malloc(bytes);
+      if (!q) throw std::bad_alloc();
+      p_.reset(static_cast<double*>(q));
+      cap_ = count;
+    }
+    size_ = count;
+  }
+  kcd* data() { return reinterpret_cast<kcd*>(p_.get()); }
+  const kcd* data() const { return reinterpret_cast<const kcd*>(p_.get()); }
+  kcd& operator[](size_t i) { return data()[i]; }
+  const kcd& operator[](size_t i) const { return data()[i]; }
+  size_t size() const { return size_; }
+
+ private:
+  struct Free {
+    void operator()(double* q) const { std::free(q); }
+  };
+  std::unique_ptr<double, Free> p_;
+  size_t cap_ = 0, size_ = 0;
+};
+
 struct BandFactors {
   int n = 0, K = 0;
-  std::vector<kcd> U;
+  RawArray U;
   std::vector<kcd> L;  // empty when the factors are used for the right-hand sides given only
   std::vector<std::uint8_t> piv;
 };

@@ -167,29 +167,37 @@ class ModelRows {
 
   void row(int r, int base, cd* out) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
-    for (int j = 0; j <= 2 * K_; ++j) {
+    const int lo = std::max(0, r - K_ - base), hi = std::min({2 * K_, r + K_ - base, g_.N - 1 - base});
+    const cd* a = m_.a().data();
+    for (int j = 0; j < lo; ++j) out[j] = cd(0.0, 0.0);
+    for (int j = lo; j <= hi; ++j) {
       const int c = base + j;
-      out[j] = (c < g_.N && c - r <= K_ && r - c <= K_)
-                   ? detail::band_entry(m_.a().col(K_ + r - c).data(), pw(c), na_)
-                   : cd(0.0, 0.0);
+      out[j] = detail::band_entry(a + static_cast<size_t>(K_ + r - c) * (na_ + 1), pw(c), na_);
     }
+    for (int j = hi + 1; j <= 2 * K_; ++j) out[j] = cd(0.0, 0.0);
   }
 
   void rhs(int r, cd* z) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
-    for (int q = 0; q < nrhs_; ++q) z[q] = cd(0.0, 0.0);
-    if (nrhs_) {
-      for (int c = std::max(0, r - Kb_); c <= std::min(g_.N - 1, r + Kb_); ++c) {
-        if (!nonzero_[c]) continue;
-        const cd v = detail::band_entry(m_.b().col(Kb_ + r - c).data(), pw(c), nb_);
-        for (int q = 0; q < nrhs_; ++q) z[q] += v * (*U_)(c, q);
+    const cd* b = m_.b().data();
+    const int lo = std::max(0, r - Kb_), hi = std::min(g_.N - 1, r + Kb_);
+    for (int q = 0; q < nrhs_; ++q) {
+      const cd* u = U_->data() + static_cast<size_t>(q) * g_.N;
+      double re = 0.0, im = 0.0;
+      for (int c = lo; c <= hi; ++c) {
+        if (!nonzero_[c]) continue;  // B U costs nothing on lines without input
+        const cd v = detail::band_entry(b + static_cast<size_t>(Kb_ + r - c) * (nb_ + 1), pw(c), nb_);
+        re += v.real() * u[c].real() - v.imag() * u[c].imag();
+        im += v.real() * u[c].imag() + v.imag() * u[c].real();
       }
+      z[q] = cd(re, im);
     }
+    const double* absa = absa_.data();
     double mag = 0;
     for (int c = std::max(0, r - K_); c <= std::min(g_.N - 1, r + K_); ++c)
-      mag += detail::band_entry(absa_.col(K_ + r - c).data(), wn(c), na_);
-    phase_ = (r % 256 == 0) ? std::polar(1.0, kGoldenAngle * r) : detail::cmul(phase_, step_);
-    z[nrhs_] = mag * phase_;
+      mag += detail::band_entry(absa + static_cast<size_t>(K_ + r - c) * (na_ + 1), wn(c), na_);
+    phase_ = (r & 255) == 0 ? std::polar(1.0, kGoldenAngle * r) : detail::cmul(phase_, step_);
+    z[nrhs_] = cd(mag * phase_.real(), mag * phase_.imag());
   }
 
  private:
@@ -200,7 +208,9 @@ class ModelRows {
     for (; next_ <= c; ++next_) {
       const cd s = detail::line_variable(m_.w0(), m_.ts(), g_.line_of(next_));
       detail::line_powers(s, P_ - 1, &pw_[static_cast<size_t>(next_ & mask_) * P_]);
-      detail::line_powers(std::abs(s), na_, &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)]);
+      // |s|: the line's |w| in continuous time, 1 up to rounding in discrete time (no hypot).
+      const double as = s.real() == 0.0 ? std::abs(s.imag()) : std::sqrt(std::norm(s));
+      detail::line_powers(as, na_, &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)]);
     }
   }
   const Model& m_;
@@ -228,7 +238,8 @@ FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXc
                             const std::function<std::string(int)>& label) {
   ModelRows src(m, g, U);
   const int n = g.N, K = m.ka(), nz = src.columns();
-  std::vector<cd> z(static_cast<size_t>(n + 2 * K) * nz);
+  detail::RawArray z;
+  z.resize(static_cast<size_t>(n + 2 * K) * nz);
   try {
     detail::dispatch_band(K, [&](auto kt) {
       detail::factor_band<decltype(kt)::value>(src, n, K, nz, f, keep_L, z.data());
@@ -246,9 +257,10 @@ FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXc
   for (int i = 0; i < n; ++i) {
     const cd* zi = &z[static_cast<size_t>(i) * nz];
     for (int q = 0; q < nu; ++q) out.Y(i, q) = zi[q];
-    const double a = std::abs(zi[nu]);
+    const double a = std::norm(zi[nu]);
     if (a > out.condition || !(a == a)) out.condition = a, out.where = i;
   }
+  out.condition = std::abs(z[static_cast<size_t>(out.where) * nz + nu]);
   if (!out.Y.allFinite()) throw NumericalError("band solve produced NaN or inf");
   return out;
 }
