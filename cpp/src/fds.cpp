@@ -1,5 +1,6 @@
 #include "lptv/fds.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -407,6 +408,44 @@ int last_nonzero_line(const Eigen::MatrixXcd& U) {
 
 }  // namespace
 
+namespace {
+
+// The factor 10 cond of the truncation bound, taken before the factorisation gives cond
+// (Fds::condition): 10 x 30. A larger condition number costs a second grid, not accuracy.
+constexpr double kAssumedCondition = 300.0;
+
+}  // namespace
+
+double decay_per_line(const Model& m) {
+  // Far from line 0 row l of A is (j w0 l)^na sum_k a_{na,k} Y_{l-k} up to O(1/l), so beyond
+  // the excited lines Y_l behaves like a sum of lambda^l over the roots of
+  // sum_k a_{na,k} lambda^(kmax-k) (the harmonics of a_na(t), kmin..kmax those that are
+  // nonzero): roots inside the unit circle decay towards +inf, those outside towards -inf.
+  // The slowest of either side is the prediction. A root on the circle (a_na(t) has a real
+  // zero) decays not at all: 1.
+  const int K = m.ka(), na = m.na();
+  int lo = -K, hi = K;
+  while (lo <= hi && m.a()(na, K + lo) == cd(0.0, 0.0)) ++lo;
+  while (hi >= lo && m.a()(na, K + hi) == cd(0.0, 0.0)) --hi;
+  if (hi <= lo) return 0.0;  // a_na constant (or a single harmonic): no coupling at the top order
+  const int deg = hi - lo;
+  // Companion matrix of the monic polynomial lambda^deg + sum c_i lambda^i.
+  Eigen::MatrixXcd C = Eigen::MatrixXcd::Zero(deg, deg);
+  const cd lead = m.a()(na, K + lo);  // coefficient of lambda^(hi - lo)
+  for (int i = 0; i < deg; ++i) {
+    // lambda^i has the coefficient a_{na, hi - i}.
+    C(0, deg - 1 - i) = -m.a()(na, K + hi - i) / lead;
+    if (i + 1 < deg) C(i + 1, i) = 1.0;
+  }
+  const Eigen::VectorXcd roots = Eigen::ComplexEigenSolver<Eigen::MatrixXcd>(C, false).eigenvalues();
+  double q = 0;
+  for (Eigen::Index i = 0; i < roots.size(); ++i) {
+    const double r = std::abs(roots[i]);
+    q = std::max(q, r < 1 ? r : 1 / r);
+  }
+  return q;
+}
+
 SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const SimulateOptions& opt) {
   check_input(U);
   SimulateResult res;
@@ -481,9 +520,17 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
   // well-conditioned, fast-decaying system); otherwise double the guard until two grids agree
   // to tol, or the bound of the larger one is below tol.
   const int max_guard = opt.max_guard >= 0 ? opt.max_guard : std::max(1024, 4 * band);
-  // A start that is small next to the band costs little and, for the fast decay of most
-  // systems, is already enough: one factorisation.
+  const int excited = last_nonzero_line(U);
+  // The first grid is sized from the decay the model predicts beyond the excited lines
+  // (decay_per_line): normally it meets the bound, one factorisation. Without a prediction
+  // (a_na(t) vanishing somewhere), a start that is small next to the band.
   int guard = std::max({16, 4 * K, band / 256});
+  const double q = decay_per_line(m);
+  if (q > 0 && q < 1) {
+    const double D = 1.25 * std::log(opt.tol / kAssumedCondition) / std::log(q) + 2 * K;
+    guard = std::max(4 * K, static_cast<int>(std::ceil(std::min(D, 1e9))) - (band - excited));
+  }
+  guard = std::min(guard, max_guard);
   Run prev = run(band, guard);
   res.Y = prev.Y;
   res.guard = guard;
@@ -492,7 +539,10 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     res.converged = true;
     return res;
   }
-  const int excited = last_nonzero_line(U);
+  if (guard >= max_guard) {
+    res.converged = false;
+    return res;
+  }
   while (true) {
     // The output decays about geometrically beyond the last excited line: from the edge
     // value at distance D, the distance where the bound meets tol, with a margin.

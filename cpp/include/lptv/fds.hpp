@@ -108,6 +108,13 @@ struct SimulateResult {
   Solver solver = Solver::Auto;  // backend actually used
 };
 
+// The decay per line the model predicts for its output beyond the excited lines, far from
+// line 0: the largest |lambda| < 1 and 1/|lambda| > 1 over the roots of
+// sum_k a_{na,k} lambda^-k = 0 (the harmonics of a_na(t)). 0 when a_na is constant (the top
+// order does not couple lines), 1 when a root is on the unit circle (no decay). simulate sizes
+// its first adaptive grid from it.
+double decay_per_line(const Model& m);
+
 // U: one-sided spectra on lines 0..Lu (rows), one column per input; U(0) and, in
 // discrete time with even N, U(N/2) must be real. X_l = fft(x)[l] / N.
 SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U,
