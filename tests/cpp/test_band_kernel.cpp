@@ -175,3 +175,21 @@ TEST_CASE("FDS band kernel equals LAPACK's band LU and KLU for every bandwidth",
     }
   }
 }
+
+TEST_CASE("the predicted decay beyond the band is the root of a_na's harmonics", "[fds]") {
+  // a_1(t) = 1 + 2 rho cos(w0 t + phi): rho e^{-j phi} + lambda + rho e^{j phi} lambda^2 = 0
+  // has |lambda| = (1 - sqrt(1 - 4 rho^2)) / (2 rho) and its reciprocal.
+  for (double rho : {0.1, 0.3, 0.49}) {
+    const cd h = std::polar(rho, 0.7);
+    Eigen::MatrixXcd a(2, 3), b(1, 1);
+    a << 0.2, 0.5, 0.2, std::conj(h), 1.0, h;
+    b << 1.0;
+    const double expected = (1 - std::sqrt(1 - 4 * rho * rho)) / (2 * rho);
+    REQUIRE(lptv::decay_per_line(lptv::Model(a, b, 0.3)) == Approx(expected).epsilon(1e-12));
+  }
+  // A constant top coefficient: no coupling at the top order, no prediction.
+  Eigen::MatrixXcd a(2, 3), b(1, 1);
+  a << 0.1, 1.0, 0.1, 0.0, 1.0, 0.0;
+  b << 1.0;
+  REQUIRE(lptv::decay_per_line(lptv::Model(a, b, 0.3)) == 0.0);
+}
