@@ -125,54 +125,55 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
   if (keep_L) f.L.assign(static_cast<size_t>(n) * std::max(K, 1), kcd(0.0, 0.0));
   else f.L.clear();
   std::vector<kcd> win(static_cast<size_t>(K + 1) * W), zw(static_cast<size_t>(K + 1) * std::max(nz, 1));
-  int slot[KT >= 0 ? KT + 1 : 1];
-  std::vector<int> slot_rt(KT >= 0 ? 0 : K + 1);
-  int* sl = KT >= 0 ? slot : slot_rt.data();
-  for (int i = 0; i <= K; ++i) sl[i] = i;
+  // Position i of the window at step k lives in slot (k + i) mod (K + 1): the row that leaves
+  // frees the slot of the row that enters next. A pivot swap exchanges the two rows' contents
+  // (rare in the FDS's diagonally dominant rows), so no slot table sits between the loads.
   auto wrow = [&](int s) { return &win[static_cast<size_t>(s) * W]; };
   auto zrow = [&](int s) { return &zw[static_cast<size_t>(s) * nz]; };
   // Rows 0..K-1 enter against columns 0..2K.
   for (int r = 0; r < std::min(K, n); ++r) {
-    src.row(r, 0, wrow(sl[r]));
-    if (nz) src.rhs(r, zrow(sl[r]));
+    src.row(r, 0, wrow(r));
+    if (nz) src.rhs(r, zrow(r));
   }
+  int s0 = 0;  // slot of position 0 at step k, k mod (K + 1)
   for (int k = 0; k < n; ++k) {
+    auto slot = [&](int i) { return s0 + i <= K ? s0 + i : s0 + i - (K + 1); };
     if (k + K < n) {
-      src.row(k + K, k, wrow(sl[K]));
-      if (nz) src.rhs(k + K, zrow(sl[K]));
+      src.row(k + K, k, wrow(slot(K)));
+      if (nz) src.rhs(k + K, zrow(slot(K)));
     }
     const int m = std::min(K, n - 1 - k);  // rows below the pivot row in the window
     int p = 0;
-    double best = cabs1(wrow(sl[0])[0]);
+    double best = cabs1(wrow(s0)[0]);
     for (int i = 1; i <= m; ++i) {
-      const double v = cabs1(wrow(sl[i])[0]);
+      const double v = cabs1(wrow(slot(i))[0]);
       if (v > best) best = v, p = i;
     }
     if (best == 0.0) throw ZeroPivot{k};
-    std::swap(sl[0], sl[p]);
+    if (p) {
+      std::swap_ranges(wrow(s0), wrow(s0) + W, wrow(slot(p)));
+      std::swap_ranges(zrow(s0), zrow(s0) + nz, zrow(slot(p)));
+    }
     f.piv[k] = static_cast<std::uint8_t>(p);
-    const kcd* P = wrow(sl[0]);
+    const kcd* P = wrow(s0);
     kcd* Uk = &f.U[static_cast<size_t>(k) * W];
     const kcd inv = crecip(P[0]);
     Uk[0] = inv;
     for (int j = 1; j < W; ++j) Uk[j] = P[j];
-    const kcd* zp = zrow(sl[0]);
+    const kcd* zp = zrow(s0);
     kcd* zk = z + static_cast<size_t>(k) * nz;
     for (int c = 0; c < nz; ++c) zk[c] = zp[c];
     for (int i = 1; i <= m; ++i) {
-      kcd* R = wrow(sl[i]);
+      kcd* R = wrow(slot(i));
       const kcd l = cmul(R[0], inv);
       if (keep_L) f.L[static_cast<size_t>(k) * K + (i - 1)] = l;
       // Eliminate column k and shift the row one column left (the window moves with k).
       for (int j = 1; j < W; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
       R[W - 1] = kcd(0.0, 0.0);
-      kcd* zr = zrow(sl[i]);
+      kcd* zr = zrow(slot(i));
       for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
     }
-    // The pivot row leaves; its slot takes the row that enters at the next step.
-    const int out = sl[0];
-    for (int i = 0; i < K; ++i) sl[i] = sl[i + 1];
-    sl[K] = out;
+    s0 = s0 == K ? 0 : s0 + 1;
   }
   std::fill(z + static_cast<size_t>(n) * nz, z + static_cast<size_t>(n + 2 * K) * nz, kcd(0.0, 0.0));
 }
