@@ -180,7 +180,7 @@ def main(max_lines: int = 10**6):
                   lambda: banded_route(model, U, g)], 200)
     print(f"\ncall overhead, L = 10 (guard {g}): sim {1e6 * t[0]:.0f} us, sim/g {1e6 * t[1]:.0f} us, "
           f"banded {1e6 * t[2]:.0f} us")
-    print("ratios > 1 mean lptv.simulate is slower than solve_banded; goal: sim/band <= 1 at "
+    print("ratios > 1 mean lptv.simulate is slower than solve_banded; goal (issue 9): sim/band <= 0.5 at "
           "L = 10^5 (the default solver)")
 
 

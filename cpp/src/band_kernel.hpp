@@ -99,7 +99,7 @@ class RawArray {
 struct BandFactors {
   int n = 0, K = 0;
   RawArray U;
-  std::vector<kcd> L;  // empty when the factors are used for the right-hand sides given only
+  RawArray L;  // empty when the factors are used for the right-hand sides given only
   std::vector<std::uint8_t> piv;
 };
 
@@ -122,8 +122,7 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
   f.K = K;
   f.U.resize(static_cast<size_t>(n) * W);
   f.piv.resize(n);
-  if (keep_L) f.L.assign(static_cast<size_t>(n) * std::max(K, 1), kcd(0.0, 0.0));
-  else f.L.clear();
+  f.L.resize(keep_L ? static_cast<size_t>(n) * std::max(K, 1) : 0);
   std::vector<kcd> win(static_cast<size_t>(K + 1) * W), zw(static_cast<size_t>(K + 1) * std::max(nz, 1));
   // Position i of the window at step k lives in slot (k + i) mod (K + 1): the row that leaves
   // frees the slot of the row that enters next. A pivot swap exchanges the two rows' contents
@@ -173,6 +172,8 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
       kcd* zr = zrow(slot(i));
       for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
     }
+    if (keep_L)  // no rows below the last ones: zero multipliers
+      for (int i = m + 1; i <= K; ++i) f.L[static_cast<size_t>(k) * K + (i - 1)] = kcd(0.0, 0.0);
     s0 = s0 == K ? 0 : s0 + 1;
   }
   std::fill(z + static_cast<size_t>(n) * nz, z + static_cast<size_t>(n + 2 * K) * nz, kcd(0.0, 0.0));

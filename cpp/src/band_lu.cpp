@@ -101,7 +101,7 @@ int SmallBandLU::pivot(int k) const { return f_->piv.at(k); }
 Eigen::MatrixXcd SmallBandLU::solve(const Eigen::MatrixXcd& rhs) const {
   const int n = f_->n, K = f_->K;
   if (rhs.rows() != n) throw std::invalid_argument("solve: right-hand side has wrong size");
-  if (f_->L.empty()) throw std::logic_error("SmallBandLU: factors kept for their own right-hand sides only");
+  if (f_->L.size() == 0) throw std::logic_error("SmallBandLU: factors kept for their own right-hand sides only");
   const Eigen::Index ncol = rhs.cols();
   Eigen::MatrixXcd x(n, ncol);
   if (ncol == 0) return x;
