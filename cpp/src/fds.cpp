@@ -359,10 +359,18 @@ Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {
 
 namespace {
 
+// max |x_ij| without a hypot per entry (the square root of the largest |x|^2; cwiseAbs where
+// the squares overflow).
+double max_abs(const Eigen::MatrixXcd& x) {
+  if (x.size() == 0) return 0.0;
+  const double m2 = x.cwiseAbs2().maxCoeff();
+  return std::isfinite(m2) ? std::sqrt(m2) : x.cwiseAbs().maxCoeff();
+}
+
 void check_input(const Eigen::MatrixXcd& U) {
   if (U.rows() < 1 || U.cols() < 1) throw std::invalid_argument("U must not be empty");
   if (!U.allFinite()) throw std::invalid_argument("U contains NaN or inf");
-  const double scale = std::max(U.cwiseAbs().maxCoeff(), 1e-300);
+  const double scale = std::max(max_abs(U), 1e-300);
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
     if (std::abs(U(0, j).imag()) > 1e-12 * scale) {
       throw std::invalid_argument(
@@ -459,7 +467,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
                                   std::to_string(g.N / 2));
     }
     if (g.N % 2 == 0 && Lu == g.N / 2) {
-      const double scale = std::max(U.cwiseAbs().maxCoeff(), 1e-300);
+      const double scale = std::max(max_abs(U), 1e-300);
       if (U.row(Lu).imag().cwiseAbs().maxCoeff() > 1e-12 * scale) {
         throw std::invalid_argument("U: the Nyquist line N/2 must be real for a real input signal");
       }
@@ -494,7 +502,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     const GridSolution s = solve_grid(m, g.L, to_full(g, U), opt.solver);
     res.solver = s.solver;
     const Eigen::MatrixXcd& full = s.Y;
-    const double peak = std::max(full.cwiseAbs().maxCoeff(), 1e-300);
+    const double peak = std::max(max_abs(full), 1e-300);
     double edge = 0;
     for (int l = std::max(0, g.L - K + 1); l <= g.L; ++l) {
       edge = std::max(edge, full.row(g.index_of(l)).cwiseAbs().maxCoeff());
@@ -556,7 +564,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     }
     next = std::min(next, std::max(max_guard, 2 * guard));
     Run cur = run(band, next);
-    const double peak = std::max(cur.Y.cwiseAbs().maxCoeff(), 1e-300);
+    const double peak = std::max(max_abs(cur.Y), 1e-300);
     const double diff = (cur.Y - prev.Y).cwiseAbs().maxCoeff() / peak;
     res.Y = cur.Y;
     res.guard = next;
