@@ -1,6 +1,7 @@
 #include "lptv/band_lu.hpp"
 
 #include <cmath>
+#include <exception>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -129,9 +130,17 @@ Eigen::MatrixXcd SmallBandLU::solve(const Eigen::MatrixXcd& rhs) const {
   if (nblocks >= 2 && static_cast<double>(n) * static_cast<double>(ncol) >= 2e5 &&
       std::thread::hardware_concurrency() >= 2) {
     const Eigen::Index mid = nblocks / 2;
-    std::thread t([&] { run(0, mid); });
+    std::exception_ptr failure;  // an allocation failure on the second thread, rethrown here
+    std::thread t([&] {
+      try {
+        run(0, mid);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+    });
     run(mid, nblocks);
     t.join();
+    if (failure) std::rethrow_exception(failure);
   } else {
     run(0, nblocks);
   }
