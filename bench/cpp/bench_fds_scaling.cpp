@@ -1,5 +1,6 @@
-// FDS cost per line from 10^3 to 10^7 lines: LAPACK's band LU (the continuous-time default)
-// against KLU and UMFPACK, with peak memory.
+// FDS cost per line from 10^3 to 10^7 lines: the band LU (lptv::SmallBandLU, the
+// continuous-time default) against KLU and UMFPACK, with peak memory; the one-pass route of
+// lptv::simulate (lptv::solve_grid) against a memory copy of the bytes it must move.
 //
 // The paper-like model (7 diagonals in A and B) on a fixed grid -L..L with n = 2L+1 lines and
 // one random full-grid input: lptv::Fds (build A, factorise it, check its conditioning with one
@@ -19,6 +20,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -31,6 +33,12 @@
 namespace {
 
 enum Route { kBand, kKLU, kUMFPACK, kRoutes };
+
+// Bytes per line the one-pass band route must move at least, K = 3 and one input: the input
+// line (16) read, the factors' row (2K + 1 = 7 complex, 112) written and read back, the two
+// eliminated right-hand sides (input and check, 32) written and read back, the output line
+// (16) written.
+constexpr int kFloorBytes = 16 + 2 * 112 + 2 * 32 + 16;
 const char* const kRouteName[kRoutes] = {"band", "klu", "umfpack"};
 const lptv::Solver kRouteSolver[kRoutes] = {lptv::Solver::Band, lptv::Solver::KLU,
                                             lptv::Solver::UMFPACK};
@@ -40,6 +48,11 @@ struct Measurement {
   // factorise + check) and solve_full (B U + solve). Measured apart: building A alone, the
   // factorisation alone on a prebuilt A, and KLU's analysis and numeric factorisation.
   double ctor = 0, solve = 0, build = -1, factor = -1, part1 = -1, part2 = -1;
+  // Band route only: lptv::solve_grid (one pass: build A, factorise, B U, check, both
+  // substitutions; what simulate does per grid), and the copy floor: memcpy of kFloorBytes
+  // per line from one warm array to another (STREAM's copy: the bytes read plus those written
+  // equal the bytes the one-pass route must move at least, see kFloorBytes).
+  double fused = -1, copy = -1, fused_diff = 0;
   long rss_base_kb = 0, rss_peak_kb = 0;
   double residual = 0;   // |A Y - B U| / (|A| |Y| + |B U|), max norms
   double condition = 0;  // Fds::condition()
@@ -157,13 +170,22 @@ Measurement measure(const lptv::Model& model, int L, Route route) {
     const std::vector<lptv::cd> ab = band_storage(A, K);
     repeat([&] {
       std::vector<lptv::cd> copy = ab;
-      timed(&m.factor, [&] { const lptv::BandLU lu(g.N, K, K, std::move(copy), label); });
+      timed(&m.factor, [&] { const lptv::SmallBandLU lu(g.N, K, copy, label); });
     });
   } else {
     repeat([&] {
       timed(&m.factor, [&] { const lptv::SparseLU lu(A, solver, label); });
       if (route == kKLU) klu_parts(A, &m.part1, &m.part2);
     });
+  }
+  if (route == kBand) {
+    Eigen::MatrixXcd Yf;
+    repeat([&] { timed(&m.fused, [&] { Yf = lptv::solve_grid(model, L, U, lptv::Solver::Band).Y; }); });
+    m.fused_diff = (Yf - Y).cwiseAbs().maxCoeff() / Y.cwiseAbs().maxCoeff();
+    const size_t bytes = static_cast<size_t>(kFloorBytes) * g.N / 2;
+    std::vector<char> src(bytes, 1), dst(bytes, 0);
+    repeat([&] { timed(&m.copy, [&] { std::memcpy(dst.data(), src.data(), bytes); }); });
+    if (dst[bytes / 3] != 1) throw std::runtime_error("copy failed");
   }
   m.ok = 1;
   return m;
@@ -225,6 +247,8 @@ Measurement merge(const Measurement& a, const Measurement& b) {
   m.factor = fastest(a.factor, b.factor);
   m.part1 = fastest(a.part1, b.part1);
   m.part2 = fastest(a.part2, b.part2);
+  m.fused = fastest(a.fused, b.fused);
+  m.copy = fastest(a.copy, b.copy);
   m.rss_peak_kb = std::max(a.rss_peak_kb - a.rss_base_kb, b.rss_peak_kb - b.rss_base_kb);
   m.rss_base_kb = 0;
   return m;
@@ -349,13 +373,14 @@ int main(int argc, char** argv) {
   }
 
   std::printf("\nwhere the constructor's time goes, ns per line: build A and the factorisation of a "
-              "prebuilt A each timed alone (fastest run);\ncheck = Fds ctor - build - "
-              "factorisation (Fds's conditioning check: one more solve); KLU's factorisation = "
+              "prebuilt A each timed alone (fastest run; band: A in LAPACK storage and\nSmallBandLU on it); "
+              "check = Fds ctor - build - factorisation (the conditioning check: band, eliminated with "
+              "the factorisation;\nthe others, one more solve); KLU's factorisation = "
               "analysis (AMD + BTF)\n+ numeric factorisation + rcond\n");
   std::printf("%10s %8s %8s %8s | %8s %8s %8s %8s %8s | %8s %8s %8s\n", "", "band", "", "", "klu",
               "", "", "", "", "umfpack", "", "");
   std::printf("%10s %8s %8s %8s | %8s %8s %8s %8s %8s | %8s %8s %8s\n", "lines", "build",
-              "zgbtrf", "check", "build", "analysis", "numeric", "rcond", "check", "build",
+              "factor", "check", "build", "analysis", "numeric", "rcond", "check", "build",
               "factor", "check");
   auto ns = [](double seconds, double n) {
     if (seconds < 0) std::printf(" %8s", "-");
@@ -379,6 +404,27 @@ int main(int argc, char** argv) {
     }
     std::printf("\n");
   }
+
+  std::printf("\nthe one-pass band route (lptv::solve_grid: build A, factorise, B U, check, both "
+              "substitutions), ns per line,\nagainst a copy of %d bytes per line (memcpy between two "
+              "warm arrays of %d bytes per line: the bytes the route must move at least)\n",
+              kFloorBytes, kFloorBytes / 2);
+  std::printf("%10s %10s %10s %8s %10s\n", "lines", "one-pass", "copy", "ratio", "vs route");
+  double flo = 1e300, fhi = 0;
+  for (const Row& r : rows) {
+    const Measurement& m = r.m[kBand];
+    if (!m.ok || m.fused < 0) continue;
+    const double n = double(r.n);
+    std::printf("%10ld %10.1f %10.1f %8.2f %10.1e\n", r.n, 1e9 * m.fused / n, 1e9 * m.copy / n,
+                m.fused / m.copy, m.fused_diff);
+    flo = std::min(flo, m.fused / n);
+    fhi = std::max(fhi, m.fused / n);
+    if (!(m.fused_diff <= 1e-12)) {
+      std::fprintf(stderr, "solve_grid disagrees with Fds at n = %ld: %.1e\n", r.n, m.fused_diff);
+      failed = true;
+    }
+  }
+  if (fhi > 0) std::printf("one-pass spread (max / min): %.2fx\n", fhi / flo);
 
   std::printf("\nspread of the time per line (max / min over the sizes that ran; goal: within 2x "
               "from 10^3 to 10^7):");

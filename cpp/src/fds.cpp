@@ -1,10 +1,13 @@
 #include "lptv/fds.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 
+#include "band_kernel.hpp"
 #include "band_row.hpp"
 #include "lptv/errors.hpp"
 
@@ -102,14 +105,192 @@ Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& 
   return out;
 }
 
+namespace {
+
+constexpr double kGoldenAngle = 2.399963229728653;
+
+// The conditioning check's right-hand side (see Fds::condition): row i's magnitude of terms,
+// sum over its entries of sum_n |a_{n,k}| |s_j|^n, times the unit phase exp(j g i) of the
+// golden angle g. This is the route of the sparse solvers and of LAPACK's band LU; the small
+// band kernel forms the same vector row by row (ModelRows below).
+Eigen::VectorXcd check_rhs(const Model& m, const Grid& grid) {
+  const int K = m.ka(), na = m.na();
+  const Eigen::MatrixXd absa = m.a().cwiseAbs();  // |a_{n,k}|, once
+  Eigen::VectorXd mag = Eigen::VectorXd::Zero(grid.N);
+  std::vector<double> wn(na + 1);
+  for (int j = 0; j < grid.N; ++j) {
+    const int i = grid.line_of(j);
+    detail::line_powers(std::abs(detail::line_variable(m.w0(), m.ts(), i)), na, wn.data());
+    for (int k = -K; k <= K; ++k) {
+      const int row = grid.index_of(i + k);
+      if (row >= 0) mag[row] += detail::band_entry(absa.col(K + k).data(), wn.data(), na);
+    }
+  }
+  Eigen::VectorXcd b(grid.N);
+  for (int i = 0; i < grid.N; ++i) b[i] = mag[i] * std::polar(1.0, kGoldenAngle * i);
+  return b;
+}
+
+// The refusal of Fds::Fds: fewer than 3 digits left.
+void check_condition(double condition, int where, const std::function<std::string(int)>& label) {
+  if (!(condition < Fds::kMaxCondition)) {
+    std::ostringstream msg;
+    msg << "A is numerically singular near " << label(where)
+        << " (condition number with respect to the coefficients above " << condition
+        << "): a pole on or next to that line, or a_na(t) nearly vanishes";
+    throw NumericalError(msg.str());
+  }
+}
+
+// The rows of A of a continuous-time model on the grid -L..L for the small band kernel, built
+// from the band-row kernel (the same band_entry calls on the same powers as build_A and
+// band_storage_A, so the same bits), and the right-hand sides of each row: (B U)_r for the
+// columns of U (when given), then the conditioning check's entry (check_rhs, the phase by a
+// recurrence re-anchored every 256 rows).
+class ModelRows {
+ public:
+  ModelRows(const Model& m, const Grid& g, const Eigen::MatrixXcd* U)
+      : m_(m), g_(g), U_(U), K_(m.ka()), Kb_(m.kb()), na_(m.na()), nb_(m.nb()),
+        P_(std::max(na_, nb_) + 1), absa_(m.a().cwiseAbs()) {
+    int R = 1;
+    while (R < 2 * std::max(K_, Kb_) + 1) R *= 2;
+    mask_ = R - 1;
+    pw_.resize(static_cast<size_t>(R) * P_);
+    wn_.resize(static_cast<size_t>(R) * (na_ + 1));
+    nrhs_ = U ? static_cast<int>(U->cols()) : 0;
+    if (U) {
+      nonzero_.resize(g.N);
+      for (int i = 0; i < g.N; ++i) nonzero_[i] = !U->row(i).isZero(0.0);
+    }
+    step_ = std::polar(1.0, kGoldenAngle);
+  }
+  int columns() const { return nrhs_ + 1; }
+
+  void row(int r, int base, cd* out) {
+    ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
+    const int lo = std::max(0, r - K_ - base), hi = std::min({2 * K_, r + K_ - base, g_.N - 1 - base});
+    const cd* a = m_.a().data();
+    for (int j = 0; j < lo; ++j) out[j] = cd(0.0, 0.0);
+    for (int j = lo; j <= hi; ++j) {
+      const int c = base + j;
+      out[j] = detail::band_entry(a + static_cast<size_t>(K_ + r - c) * (na_ + 1), pw(c), na_);
+    }
+    for (int j = hi + 1; j <= 2 * K_; ++j) out[j] = cd(0.0, 0.0);
+  }
+
+  void rhs(int r, cd* z) {
+    ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
+    const cd* b = m_.b().data();
+    const int lo = std::max(0, r - Kb_), hi = std::min(g_.N - 1, r + Kb_);
+    for (int q = 0; q < nrhs_; ++q) {
+      const cd* u = U_->data() + static_cast<size_t>(q) * g_.N;
+      double re = 0.0, im = 0.0;
+      for (int c = lo; c <= hi; ++c) {
+        if (!nonzero_[c]) continue;  // B U costs nothing on lines without input
+        const cd v = detail::band_entry(b + static_cast<size_t>(Kb_ + r - c) * (nb_ + 1), pw(c), nb_);
+        re += v.real() * u[c].real() - v.imag() * u[c].imag();
+        im += v.real() * u[c].imag() + v.imag() * u[c].real();
+      }
+      z[q] = cd(re, im);
+    }
+    const double* absa = absa_.data();
+    double mag = 0;
+    for (int c = std::max(0, r - K_); c <= std::min(g_.N - 1, r + K_); ++c)
+      mag += detail::band_entry(absa + static_cast<size_t>(K_ + r - c) * (na_ + 1), wn(c), na_);
+    phase_ = (r & 255) == 0 ? std::polar(1.0, kGoldenAngle * r) : detail::cmul(phase_, step_);
+    z[nrhs_] = cd(mag * phase_.real(), mag * phase_.imag());
+  }
+
+ private:
+  const cd* pw(int c) const { return &pw_[static_cast<size_t>(c & mask_) * P_]; }
+  const double* wn(int c) const { return &wn_[static_cast<size_t>(c & mask_) * (na_ + 1)]; }
+  // Powers of the lines of the columns up to c (columns arrive in increasing order).
+  void ensure(int c) {
+    for (; next_ <= c; ++next_) {
+      const cd s = detail::line_variable(m_.w0(), m_.ts(), g_.line_of(next_));
+      detail::line_powers(s, P_ - 1, &pw_[static_cast<size_t>(next_ & mask_) * P_]);
+      // |s|: the line's |w| in continuous time, 1 up to rounding in discrete time (no hypot).
+      const double as = s.real() == 0.0 ? std::abs(s.imag()) : std::sqrt(std::norm(s));
+      detail::line_powers(as, na_, &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)]);
+    }
+  }
+  const Model& m_;
+  const Grid& g_;
+  const Eigen::MatrixXcd* U_;
+  int K_, Kb_, na_, nb_, P_, mask_ = 0, nrhs_ = 0, next_ = 0;
+  Eigen::MatrixXd absa_;
+  std::vector<cd> pw_;
+  std::vector<double> wn_;
+  std::vector<char> nonzero_;
+  cd phase_{1.0, 0.0}, step_;
+};
+
+// The small band kernel on the model's grid: factorises A with the right-hand sides of
+// ModelRows eliminated on the way, back-substitutes them, and returns the solutions of the U
+// columns (n x U.cols()) and the check's max |x_i| and where it is.
+struct FusedSolve {
+  Eigen::MatrixXcd Y;
+  double condition = 0.0;
+  int where = 0;
+};
+
+FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXcd* U,
+                            detail::BandFactors& f, bool keep_L,
+                            const std::function<std::string(int)>& label) {
+  ModelRows src(m, g, U);
+  const int n = g.N, K = m.ka(), nz = src.columns();
+  detail::RawArray z;
+  z.resize(static_cast<size_t>(n + 2 * K) * nz);
+  try {
+    detail::dispatch_band(K, [&](auto kt) {
+      detail::factor_band<decltype(kt)::value>(src, n, K, nz, f, keep_L, z.data());
+      detail::back_substitute<decltype(kt)::value>(f, nz, z.data());
+    });
+  } catch (const detail::ZeroPivot& e) {
+    std::ostringstream msg;
+    msg << "A is singular at " << label(e.column)
+        << " (a zero pivot: the system has a pole on that line, or a_na(t) vanishes)";
+    throw NumericalError(msg.str());
+  }
+  FusedSolve out;
+  const int nu = nz - 1;
+  out.Y.resize(n, nu);
+  for (int i = 0; i < n; ++i) {
+    const cd* zi = &z[static_cast<size_t>(i) * nz];
+    for (int q = 0; q < nu; ++q) out.Y(i, q) = zi[q];
+    const double a = std::norm(zi[nu]);
+    if (a > out.condition || !(a == a)) out.condition = a, out.where = i;
+  }
+  out.condition = std::abs(z[static_cast<size_t>(out.where) * nz + nu]);
+  if (!out.Y.allFinite()) throw NumericalError("band solve produced NaN or inf");
+  return out;
+}
+
+bool use_small_band(const Model& m) { return m.ka() <= SmallBandLU::kMaxK; }
+
+std::function<std::string(int)> line_label(const Grid& g) {
+  return [g](int col) { return "line " + std::to_string(g.line_of(col)); };
+}
+
+}  // namespace
+
 Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L)) {
   solver_ = solver == Solver::Auto ? default_solver(grid_.circular) : solver;
-  const Grid g = grid_;
-  auto label = [g](int col) { return "line " + std::to_string(g.line_of(col)); };
+  const auto label = line_label(grid_);
   if (solver_ == Solver::Band) {
     if (grid_.circular) {
       throw std::invalid_argument("solver: the band solver needs the continuous-time grid; the "
                                   "discrete-time grid wraps around (use 'klu' or 'umfpack')");
+    }
+    if (use_small_band(m)) {
+      // One pass: A built into the factorisation, the check's right-hand side eliminated and
+      // back-substituted with it.
+      auto f = std::make_unique<detail::BandFactors>();
+      const FusedSolve r = fused_band_solve(m, grid_, nullptr, *f, true, label);
+      small_ = std::make_unique<SmallBandLU>(std::move(f));
+      condition_ = r.condition;
+      check_condition(condition_, r.where, label);
+      return;
     }
     band_ = std::make_unique<BandLU>(grid_.N, m.ka(), m.ka(), detail::band_storage_A(m, grid_), label);
   } else {
@@ -119,33 +300,38 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   // the magnitude of the terms in each row. An entry that cancels to rounding level (a pole
   // on a grid line up to rounding) makes the solution huge exactly there; a large but
   // accurately computed entry (high frequencies, high orders) does not.
-  const int K = m.ka(), na = m.na();
-  const Eigen::MatrixXd absa = m.a().cwiseAbs();  // |a_{n,k}|, once
-  Eigen::VectorXd mag = Eigen::VectorXd::Zero(grid_.N);
-  std::vector<double> wn(na + 1);
-  for (int j = 0; j < grid_.N; ++j) {
-    const int i = grid_.line_of(j);
-    detail::line_powers(std::abs(detail::line_variable(m.w0(), m.ts(), i)), na, wn.data());
-    for (int k = -K; k <= K; ++k) {
-      const int row = grid_.index_of(i + k);
-      if (row >= 0) mag[row] += detail::band_entry(absa.col(K + k).data(), wn.data(), na);
-    }
-  }
-  Eigen::VectorXcd b(grid_.N);
-  for (int i = 0; i < grid_.N; ++i) b[i] = mag[i] * std::polar(1.0, 2.399963229728653 * i);  // golden angle
-  const Eigen::VectorXcd x = solve_A(b);
+  const Eigen::VectorXcd x = solve_A(check_rhs(m, grid_));
   Eigen::Index where = 0;
   condition_ = x.cwiseAbs().maxCoeff(&where);
-  if (!(condition_ < kMaxCondition)) {
-    std::ostringstream msg;
-    msg << "A is numerically singular near " << label(static_cast<int>(where))
-        << " (condition number with respect to the coefficients above " << condition_
-        << "): a pole on or next to that line, or a_na(t) nearly vanishes";
-    throw NumericalError(msg.str());
+  check_condition(condition_, static_cast<int>(where), label);
+}
+
+GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, Solver solver) {
+  GridSolution out;
+  out.grid = make_grid(m, L);
+  out.solver = solver == Solver::Auto ? default_solver(out.grid.circular) : solver;
+  if (U_full.rows() != out.grid.N) {
+    throw std::invalid_argument("U must have " + std::to_string(out.grid.N) +
+                                " rows (the grid), got " + std::to_string(U_full.rows()));
   }
+  if (out.solver == Solver::Band && !out.grid.circular && use_small_band(m)) {
+    const auto label = line_label(out.grid);
+    detail::BandFactors f;
+    FusedSolve r = fused_band_solve(m, out.grid, &U_full, f, false, label);
+    check_condition(r.condition, r.where, label);
+    out.Y = std::move(r.Y);
+    out.condition = r.condition;
+    return out;
+  }
+  const Fds fds(m, L, solver);
+  out.Y = fds.solve_full(U_full);
+  out.condition = fds.condition();
+  out.solver = fds.solver();
+  return out;
 }
 
 Eigen::MatrixXcd Fds::solve_A(const Eigen::MatrixXcd& rhs) const {
+  if (small_) return small_->solve(rhs);
   return band_ ? band_->solve(rhs) : lu_->solve(rhs);
 }
 
@@ -173,10 +359,18 @@ Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {
 
 namespace {
 
+// max |x_ij| without a hypot per entry (the square root of the largest |x|^2; cwiseAbs where
+// the squares overflow).
+double max_abs(const Eigen::MatrixXcd& x) {
+  if (x.size() == 0) return 0.0;
+  const double m2 = x.cwiseAbs2().maxCoeff();
+  return std::isfinite(m2) ? std::sqrt(m2) : x.cwiseAbs().maxCoeff();
+}
+
 void check_input(const Eigen::MatrixXcd& U) {
   if (U.rows() < 1 || U.cols() < 1) throw std::invalid_argument("U must not be empty");
   if (!U.allFinite()) throw std::invalid_argument("U contains NaN or inf");
-  const double scale = std::max(U.cwiseAbs().maxCoeff(), 1e-300);
+  const double scale = std::max(max_abs(U), 1e-300);
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
     if (std::abs(U(0, j).imag()) > 1e-12 * scale) {
       throw std::invalid_argument(
@@ -222,6 +416,44 @@ int last_nonzero_line(const Eigen::MatrixXcd& U) {
 
 }  // namespace
 
+namespace {
+
+// The factor 10 cond of the truncation bound, taken before the factorisation gives cond
+// (Fds::condition): 10 x 30. A larger condition number costs a second grid, not accuracy.
+constexpr double kAssumedCondition = 300.0;
+
+}  // namespace
+
+double decay_per_line(const Model& m) {
+  // Far from line 0 row l of A is (j w0 l)^na sum_k a_{na,k} Y_{l-k} up to O(1/l), so beyond
+  // the excited lines Y_l behaves like a sum of lambda^l over the roots of
+  // sum_k a_{na,k} lambda^(kmax-k) (the harmonics of a_na(t), kmin..kmax those that are
+  // nonzero): roots inside the unit circle decay towards +inf, those outside towards -inf.
+  // The slowest of either side is the prediction. A root on the circle (a_na(t) has a real
+  // zero) decays not at all: 1.
+  const int K = m.ka(), na = m.na();
+  int lo = -K, hi = K;
+  while (lo <= hi && m.a()(na, K + lo) == cd(0.0, 0.0)) ++lo;
+  while (hi >= lo && m.a()(na, K + hi) == cd(0.0, 0.0)) --hi;
+  if (hi <= lo) return 0.0;  // a_na constant (or a single harmonic): no coupling at the top order
+  const int deg = hi - lo;
+  // Companion matrix of the monic polynomial lambda^deg + sum c_i lambda^i.
+  Eigen::MatrixXcd C = Eigen::MatrixXcd::Zero(deg, deg);
+  const cd lead = m.a()(na, K + lo);  // coefficient of lambda^(hi - lo)
+  for (int i = 0; i < deg; ++i) {
+    // lambda^i has the coefficient a_{na, hi - i}.
+    C(0, deg - 1 - i) = -m.a()(na, K + hi - i) / lead;
+    if (i + 1 < deg) C(i + 1, i) = 1.0;
+  }
+  const Eigen::VectorXcd roots = Eigen::ComplexEigenSolver<Eigen::MatrixXcd>(C, false).eigenvalues();
+  double q = 0;
+  for (Eigen::Index i = 0; i < roots.size(); ++i) {
+    const double r = std::abs(roots[i]);
+    q = std::max(q, r < 1 ? r : 1 / r);
+  }
+  return q;
+}
+
 SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const SimulateOptions& opt) {
   check_input(U);
   SimulateResult res;
@@ -235,7 +467,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
                                   std::to_string(g.N / 2));
     }
     if (g.N % 2 == 0 && Lu == g.N / 2) {
-      const double scale = std::max(U.cwiseAbs().maxCoeff(), 1e-300);
+      const double scale = std::max(max_abs(U), 1e-300);
       if (U.row(Lu).imag().cwiseAbs().maxCoeff() > 1e-12 * scale) {
         throw std::invalid_argument("U: the Nyquist line N/2 must be real for a real input signal");
       }
@@ -244,9 +476,9 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     if (lines_out > g.N / 2) {
       throw std::invalid_argument("lines_out must be <= N/2 = " + std::to_string(g.N / 2));
     }
-    Fds fds(m, 0, opt.solver);
-    res.Y = to_onesided(g, fds.solve_full(to_full(g, U)), lines_out);
-    res.solver = fds.solver();
+    const GridSolution s = solve_grid(m, 0, to_full(g, U), opt.solver);
+    res.Y = to_onesided(g, s.Y, lines_out);
+    res.solver = s.solver;
     return res;
   }
 
@@ -266,17 +498,17 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     double cond;
   };
   auto run = [&](int band_lines, int guard) {
-    Fds fds(m, band_lines + guard, opt.solver);
-    res.solver = fds.solver();
-    const Eigen::MatrixXcd full = fds.solve_full(to_full(fds.grid(), U));
-    const double peak = std::max(full.cwiseAbs().maxCoeff(), 1e-300);
-    const int L = fds.grid().L;
+    const Grid g = make_grid(m, band_lines + guard);
+    const GridSolution s = solve_grid(m, g.L, to_full(g, U), opt.solver);
+    res.solver = s.solver;
+    const Eigen::MatrixXcd& full = s.Y;
+    const double peak = std::max(max_abs(full), 1e-300);
     double edge = 0;
-    for (int l = std::max(0, L - K + 1); l <= L; ++l) {
-      edge = std::max(edge, full.row(fds.grid().index_of(l)).cwiseAbs().maxCoeff());
+    for (int l = std::max(0, g.L - K + 1); l <= g.L; ++l) {
+      edge = std::max(edge, full.row(g.index_of(l)).cwiseAbs().maxCoeff());
     }
-    const double cond = std::max(1.0, fds.condition());
-    return Run{to_onesided(fds.grid(), full, lines_out), 10.0 * cond * edge / peak, edge / peak, cond};
+    const double cond = std::max(1.0, s.condition);
+    return Run{to_onesided(g, full, lines_out), 10.0 * cond * edge / peak, edge / peak, cond};
   };
   if (m.kmax() == 0) {
     // LTI: A is diagonal, lines do not couple, no truncation error.
@@ -296,9 +528,17 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
   // well-conditioned, fast-decaying system); otherwise double the guard until two grids agree
   // to tol, or the bound of the larger one is below tol.
   const int max_guard = opt.max_guard >= 0 ? opt.max_guard : std::max(1024, 4 * band);
-  // A start that is small next to the band costs little and, for the fast decay of most
-  // systems, is already enough: one factorisation.
+  const int excited = last_nonzero_line(U);
+  // The first grid is sized from the decay the model predicts beyond the excited lines
+  // (decay_per_line): normally it meets the bound, one factorisation. Without a prediction
+  // (a_na(t) vanishing somewhere), a start that is small next to the band.
   int guard = std::max({16, 4 * K, band / 256});
+  const double q = decay_per_line(m);
+  if (q > 0 && q < 1) {
+    const double D = 1.25 * std::log(opt.tol / kAssumedCondition) / std::log(q) + 2 * K;
+    guard = std::max(4 * K, static_cast<int>(std::ceil(std::min(D, 1e9))) - (band - excited));
+  }
+  guard = std::min(guard, max_guard);
   Run prev = run(band, guard);
   res.Y = prev.Y;
   res.guard = guard;
@@ -307,7 +547,10 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     res.converged = true;
     return res;
   }
-  const int excited = last_nonzero_line(U);
+  if (guard >= max_guard) {
+    res.converged = false;
+    return res;
+  }
   while (true) {
     // The output decays about geometrically beyond the last excited line: from the edge
     // value at distance D, the distance where the bound meets tol, with a margin.
@@ -321,7 +564,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     }
     next = std::min(next, std::max(max_guard, 2 * guard));
     Run cur = run(band, next);
-    const double peak = std::max(cur.Y.cwiseAbs().maxCoeff(), 1e-300);
+    const double peak = std::max(max_abs(cur.Y), 1e-300);
     const double diff = (cur.Y - prev.Y).cwiseAbs().maxCoeff() / peak;
     res.Y = cur.Y;
     res.guard = next;

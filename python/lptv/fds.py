@@ -65,8 +65,9 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     tol : float
         Relative truncation tolerance of the adaptive guard.
     solver : {'auto', 'band', 'klu', 'umfpack'}
-        The factorisation of A: 'auto' is LAPACK's band LU in continuous time (A has 2K+1
-        diagonals) and SuiteSparse's KLU in discrete time (the band wraps around the corners,
+        The factorisation of A: 'auto' is the band LU in continuous time (A has 2K+1
+        diagonals; the core's own kernel, LAPACK's for wide bands) and SuiteSparse's KLU in
+        discrete time (the band wraps around the corners,
         so 'band' is refused there).
     full_output : bool
         Return a :class:`SimulationResult` instead of ``Y``.

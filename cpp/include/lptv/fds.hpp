@@ -65,11 +65,26 @@ class Fds {
   Model model_;
   Grid grid_;
   Solver solver_;
-  std::unique_ptr<BandLU> band_;
+  std::unique_ptr<SmallBandLU> small_;  // the band solver up to SmallBandLU::kMaxK
+  std::unique_ptr<BandLU> band_;        // the band solver above (LAPACK)
   std::unique_ptr<SparseLU> lu_;
   double condition_ = 0.0;
   Eigen::MatrixXcd solve_A(const Eigen::MatrixXcd& rhs) const;
 };
+
+// One grid, one factorisation, the given inputs only (the factors are not kept): what
+// simulate does per grid. Y = A^-1 B U_full for full-grid inputs U_full (grid.N rows, any
+// number of columns), with Fds's conditioning check and its NumericalError. With the band
+// solver the factorisation, B U, the check and both substitutions are one pass over the grid;
+// the other solvers run Fds and Fds::solve_full.
+struct GridSolution {
+  Grid grid;
+  Eigen::MatrixXcd Y;
+  double condition = 0.0;  // as Fds::condition()
+  Solver solver = Solver::Auto;
+};
+GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full,
+                        Solver solver = Solver::Auto);
 
 struct SimulateOptions {
   Solver solver = Solver::Auto;
@@ -92,6 +107,13 @@ struct SimulateResult {
   bool converged = true;         // adaptive guard reached tol
   Solver solver = Solver::Auto;  // backend actually used
 };
+
+// The decay per line the model predicts for its output beyond the excited lines, far from
+// line 0: the largest |lambda| < 1 and 1/|lambda| > 1 over the roots of
+// sum_k a_{na,k} lambda^-k = 0 (the harmonics of a_na(t)). 0 when a_na is constant (the top
+// order does not couple lines), 1 when a root is on the unit circle (no decay). simulate sizes
+// its first adaptive grid from it.
+double decay_per_line(const Model& m);
 
 // U: one-sided spectra on lines 0..Lu (rows), one column per input; U(0) and, in
 // discrete time with even N, U(N/2) must be real. X_l = fft(x)[l] / N.

@@ -1,0 +1,233 @@
+// The small-band LU kernel behind lptv::SmallBandLU (band_lu.hpp): Gaussian elimination with
+// partial pivoting of a complex band matrix with K sub- and K super-diagonals, written for
+// small K (2K+1 = 3..15 unrolled by a template parameter, one runtime-K instance above).
+//
+// A streams through a window of K+1 rows. Step k holds rows k..k+K of the row-permuted matrix,
+// each as its 2K+1 entries in columns k..k+2K (pivoting fills U up to column k+2K, and only the
+// row that enters at step k reaches that far). A row enters the window when it is first
+// needed, built by a row source straight into the window: the matrix is never stored, only its
+// factors. The right-hand sides of a row (for the FDS: B U and the conditioning check) enter
+// with it and are eliminated in the same step, so that the forward substitution is part of the
+// factorisation. The pivot search, the row swap and the choice of the first largest
+// |Re| + |Im| are those of LAPACK's zgbtf2, so the pivots equal zgbtrf's on the same matrix.
+//
+// Private to the library (namespace detail); the tests reach it through SmallBandLU.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <new>
+#include <memory>
+#include <type_traits>
+#include <vector>
+
+#include "lptv/band_lu.hpp"
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
+namespace lptv {
+namespace detail {
+
+using kcd = std::complex<double>;
+
+// a - l u, and l u, written out: GCC's std::complex product guards against NaN with a library
+// call on every product, which keeps the loops below from being unrolled into plain FMAs.
+inline kcd cmul(kcd a, kcd b) {
+  return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+}
+inline kcd cmsub(kcd a, kcd l, kcd u) {
+  return {a.real() - (l.real() * u.real() - l.imag() * u.imag()),
+          a.imag() - (l.real() * u.imag() + l.imag() * u.real())};
+}
+// 1 / p by Smith's method (no overflow of |p|^2).
+inline kcd crecip(kcd p) {
+  const double a = p.real(), b = p.imag();
+  if (std::abs(a) >= std::abs(b)) {
+    const double r = b / a, id = 1.0 / (a + b * r);
+    return {id, -r * id};
+  }
+  const double r = a / b, id = 1.0 / (b + a * r);
+  return {r * id, -id};
+}
+inline double cabs1(kcd z) { return std::abs(z.real()) + std::abs(z.imag()); }
+
+// The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} (stride 2K+1); the multipliers
+// of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
+// An array of complex numbers left uninitialised on allocation (std::vector would write zeros
+// over the factors first: one more pass over the largest array of the FDS).
+// Large arrays ask Linux for transparent huge pages: at 10^7 lines the first touches of 4 KiB
+// pages (a page fault each) took a fifth of the FDS's time (bench/RESULTS.md).
+class RawArray {
+ public:
+  void resize(size_t count) {
+    if (count > cap_) {
+      const size_t bytes = 2 * count * sizeof(double);
+      void* q = nullptr;
+#ifdef __linux__
+      constexpr size_t kHuge = size_t(2) << 20;
+      if (bytes >= 2 * kHuge) {
+        if (posix_memalign(&q, kHuge, (bytes + kHuge - 1) / kHuge * kHuge) != 0) q = nullptr;
+        if (q) madvise(q, (bytes + kHuge - 1) / kHuge * kHuge, MADV_HUGEPAGE);
+      }
+#endif
+      if (!q) q = std::malloc(bytes);
+      if (!q) throw std::bad_alloc();
+      p_.reset(static_cast<double*>(q));
+      cap_ = count;
+    }
+    size_ = count;
+  }
+  kcd* data() { return reinterpret_cast<kcd*>(p_.get()); }
+  const kcd* data() const { return reinterpret_cast<const kcd*>(p_.get()); }
+  kcd& operator[](size_t i) { return data()[i]; }
+  const kcd& operator[](size_t i) const { return data()[i]; }
+  size_t size() const { return size_; }
+
+ private:
+  struct Free {
+    void operator()(double* q) const { std::free(q); }
+  };
+  std::unique_ptr<double, Free> p_;
+  size_t cap_ = 0, size_ = 0;
+};
+
+struct BandFactors {
+  int n = 0, K = 0;
+  RawArray U;
+  RawArray L;  // empty when the factors are used for the right-hand sides given only
+  std::vector<std::uint8_t> piv;
+};
+
+// Thrown through the kernel as the column of the first exactly zero pivot (the caller names it).
+struct ZeroPivot {
+  int column;
+};
+
+// Factorises the n x n band matrix given by src, eliminating nz right-hand sides on the way.
+// Source:  void row(int r, int base, kcd* out): out[j] = A(r, base + j), j = 0..2K (zero
+//          outside the band and the matrix);  void rhs(int r, kcd* z): the nz right-hand sides
+//          of row r.
+// z: (n + 2K) x nz, row-major: rows 0..n-1 receive the forward-eliminated right-hand sides,
+// the 2K rows below are set to zero (back_substitute reads past the last row).
+template <int KT, class Source>
+void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_L, kcd* z) {
+  const int K = KT >= 0 ? KT : Krt;
+  const int W = 2 * K + 1;
+  f.n = n;
+  f.K = K;
+  f.U.resize(static_cast<size_t>(n) * W);
+  f.piv.resize(n);
+  f.L.resize(keep_L ? static_cast<size_t>(n) * std::max(K, 1) : 0);
+  std::vector<kcd> win(static_cast<size_t>(K + 1) * W), zw(static_cast<size_t>(K + 1) * std::max(nz, 1));
+  // Position i of the window at step k lives in slot (k + i) mod (K + 1): the row that leaves
+  // frees the slot of the row that enters next. A pivot swap exchanges the two rows' contents
+  // (rare in the FDS's diagonally dominant rows), so no slot table sits between the loads.
+  auto wrow = [&](int s) { return &win[static_cast<size_t>(s) * W]; };
+  auto zrow = [&](int s) { return &zw[static_cast<size_t>(s) * nz]; };
+  // Rows 0..K-1 enter against columns 0..2K.
+  for (int r = 0; r < std::min(K, n); ++r) {
+    src.row(r, 0, wrow(r));
+    if (nz) src.rhs(r, zrow(r));
+  }
+  int s0 = 0;  // slot of position 0 at step k, k mod (K + 1)
+  for (int k = 0; k < n; ++k) {
+    auto slot = [&](int i) { return s0 + i <= K ? s0 + i : s0 + i - (K + 1); };
+    if (k + K < n) {
+      src.row(k + K, k, wrow(slot(K)));
+      if (nz) src.rhs(k + K, zrow(slot(K)));
+    }
+    const int m = std::min(K, n - 1 - k);  // rows below the pivot row in the window
+    int p = 0;
+    double best = cabs1(wrow(s0)[0]);
+    for (int i = 1; i <= m; ++i) {
+      const double v = cabs1(wrow(slot(i))[0]);
+      if (v > best) best = v, p = i;
+    }
+    if (best == 0.0) throw ZeroPivot{k};
+    if (p) {
+      std::swap_ranges(wrow(s0), wrow(s0) + W, wrow(slot(p)));
+      std::swap_ranges(zrow(s0), zrow(s0) + nz, zrow(slot(p)));
+    }
+    f.piv[k] = static_cast<std::uint8_t>(p);
+    const kcd* P = wrow(s0);
+    kcd* Uk = &f.U[static_cast<size_t>(k) * W];
+    const kcd inv = crecip(P[0]);
+    Uk[0] = inv;
+    for (int j = 1; j < W; ++j) Uk[j] = P[j];
+    const kcd* zp = zrow(s0);
+    kcd* zk = z + static_cast<size_t>(k) * nz;
+    for (int c = 0; c < nz; ++c) zk[c] = zp[c];
+    for (int i = 1; i <= m; ++i) {
+      kcd* R = wrow(slot(i));
+      const kcd l = cmul(R[0], inv);
+      if (keep_L) f.L[static_cast<size_t>(k) * K + (i - 1)] = l;
+      // Eliminate column k and shift the row one column left (the window moves with k).
+      for (int j = 1; j < W; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
+      R[W - 1] = kcd(0.0, 0.0);
+      kcd* zr = zrow(slot(i));
+      for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
+    }
+    if (keep_L)  // no rows below the last ones: zero multipliers
+      for (int i = m + 1; i <= K; ++i) f.L[static_cast<size_t>(k) * K + (i - 1)] = kcd(0.0, 0.0);
+    s0 = s0 == K ? 0 : s0 + 1;
+  }
+  std::fill(z + static_cast<size_t>(n) * nz, z + static_cast<size_t>(n + 2 * K) * nz, kcd(0.0, 0.0));
+}
+
+// z (rows 0..n-1 forward-eliminated, 2K zero rows below) := U^-1 z, in place.
+template <int KT>
+void back_substitute(const BandFactors& f, int nz, kcd* z) {
+  const int K = KT >= 0 ? KT : f.K;
+  const int W = 2 * K + 1;
+  for (int k = f.n - 1; k >= 0; --k) {
+    const kcd* Uk = &f.U[static_cast<size_t>(k) * W];
+    kcd* zk = z + static_cast<size_t>(k) * nz;
+    for (int c = 0; c < nz; ++c) {
+      kcd s = zk[c];
+      for (int j = 1; j < W; ++j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
+      zk[c] = cmul(s, Uk[0]);
+    }
+  }
+}
+
+// z (n + 2K rows, the last 2K zero) := L^-1 P z, in place, from the stored multipliers.
+template <int KT>
+void forward_substitute(const BandFactors& f, int nz, kcd* z) {
+  const int K = KT >= 0 ? KT : f.K;
+  for (int k = 0; k < f.n; ++k) {
+    kcd* zk = z + static_cast<size_t>(k) * nz;
+    const int p = f.piv[k];
+    if (p) std::swap_ranges(zk, zk + nz, zk + static_cast<size_t>(p) * nz);
+    const kcd* Lk = &f.L[static_cast<size_t>(k) * K];
+    for (int i = 1; i <= K; ++i) {
+      const kcd l = Lk[i - 1];
+      kcd* zi = zk + static_cast<size_t>(i) * nz;
+      for (int c = 0; c < nz; ++c) zi[c] = cmsub(zi[c], l, zk[c]);
+    }
+  }
+}
+
+// Calls f(std::integral_constant<int, K>) for K = 0..7, f(std::integral_constant<int, -1>)
+// (runtime K) above.
+template <class F>
+decltype(auto) dispatch_band(int K, F&& f) {
+  switch (K) {
+    case 0: return f(std::integral_constant<int, 0>());
+    case 1: return f(std::integral_constant<int, 1>());
+    case 2: return f(std::integral_constant<int, 2>());
+    case 3: return f(std::integral_constant<int, 3>());
+    case 4: return f(std::integral_constant<int, 4>());
+    case 5: return f(std::integral_constant<int, 5>());
+    case 6: return f(std::integral_constant<int, 6>());
+    case 7: return f(std::integral_constant<int, 7>());
+    default: return f(std::integral_constant<int, -1>());
+  }
+}
+
+}  // namespace detail
+}  // namespace lptv
