@@ -57,7 +57,9 @@ def output_spectrum(lines, Y_fds, Y_time=None, *, w0=None, ax=None, labels=("FDS
     ax.set_xlabel(xlabel)
     ax.set_ylabel("amplitude (dB)")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    handles, names = ax.get_legend_handles_labels()
+    order = sorted(range(len(names)), key=lambda i: names[i] != labels[0])
+    ax.legend([handles[i] for i in order], [names[i] for i in order])
     return ax
 
 
@@ -116,7 +118,9 @@ def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zero
         pts = np.concatenate(drawn) if drawn else np.zeros(0)
         wide = pts.size and np.ptp(pts.real) > 8 * max(np.ptp(pts.imag), 1e-12) and np.ptp(pts.imag) > 0
         equal_aspect = discrete or not wide
-    if equal_aspect and not zoom_on_poles:
+    if zoom_on_poles and equal_aspect is None:
+        equal_aspect = True
+    if equal_aspect:
         ax.set_aspect("equal", adjustable="datalim")
     return ax
 
