@@ -121,7 +121,8 @@ def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zero
     if zoom_on_poles and equal_aspect is None:
         equal_aspect = True
     if equal_aspect:
-        ax.set_aspect("equal", adjustable="datalim")
+        # with the zoom's fixed limits the box adapts; otherwise the limits do
+        ax.set_aspect("equal", adjustable="box" if zoom_on_poles else "datalim")
     return ax
 
 
