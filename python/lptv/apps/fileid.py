@@ -138,8 +138,11 @@ def add_parser(sub):
     p = sub.add_parser(
         "identify", help="identify an LPTV model from a measurement file (CSV, NPZ, MAT)",
         description=_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog="examples: lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
-               "          lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2")
+        epilog="examples:\n"
+               "  lptv identify record.csv --fs 100 --period 10 --na 2 --nb 0 --method sml\n"
+               "  lptv identify record.csv --fs 100 --period 10 --trim --skip-periods 1 --na 2 --nb 0\n"
+               "  lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
+               "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2")
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurements: .csv, .npz or .mat; several files are fitted as a batch")
     p.add_argument("--na", type=int, required=True, help="order of the output side")
@@ -250,7 +253,7 @@ def run(args) -> int:
     except OSError as e:
         return _fail(e.filename or out, e.strerror or e)
     except ImportError:
-        return _fail(src, "writing report.html needs matplotlib (pip install 'lptv[plots]')")
+        return _fail(src, "writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'")
     print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
     return 0
 
