@@ -15,7 +15,8 @@ BUILDROOT ?= build
 BUILD := $(BUILDROOT)/cpp
 PREFIX := $(CURDIR)/$(BUILDROOT)/install
 
-APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2
+# chromium: the test that renders report.html in a headless browser (about 2 minutes to install)
+APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2 chromium
 APT_BENCH := libsundials-dev
 # Python tools and test dependencies, pinned (the package's own runtime
 # dependencies are in pyproject.toml; the last line is its "batch" extra and python-control).

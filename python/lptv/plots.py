@@ -18,13 +18,23 @@ def _axes(ax, figsize=(6.4, 4.0)):
     return Figure(figsize=figsize, layout="constrained").subplots()
 
 
+def _freq_axis(lines, w0, hz):
+    """x values and label of a frequency axis: line * w0 in rad/s (or Hz), else the line number."""
+    lines = np.asarray(lines)
+    if not w0:
+        return lines, "line (multiple of the fundamental)"
+    if hz:
+        return lines * w0 / (2 * np.pi), "frequency (Hz)"
+    return lines * w0, "angular frequency (rad/s)"
+
+
 def _db(x):
     x = np.abs(np.asarray(x))
     with np.errstate(divide="ignore"):
         return 20 * np.log10(np.where(x > 0, x, np.nan))
 
 
-def output_spectrum(lines, Y_fds, Y_time=None, *, w0=None, ax=None, labels=("FDS", "CVODE")):
+def output_spectrum(lines, Y_fds, Y_time=None, *, w0=None, ax=None, labels=("FDS", "CVODE"), hz=False):
     """Output spectrum of the FDS, the time integration and their difference in dB (paper Fig. 2).
 
     Parameters
@@ -33,42 +43,68 @@ def output_spectrum(lines, Y_fds, Y_time=None, *, w0=None, ax=None, labels=("FDS
     Y_fds, Y_time : complex arrays on ``lines``
     w0 : float, optional
         Plot against angular frequency l * w0 (rad/s) instead of the line number.
+    hz : bool
+        With ``w0``: the frequency axis in Hz instead of rad/s.
     """
     ax = _axes(ax)
-    lines = np.asarray(lines)
-    x = lines * w0 if w0 else lines
-    ax.plot(x, _db(Y_fds), ".", ms=3, label=labels[0])
+    x, xlabel = _freq_axis(lines, w0, hz)
     if Y_time is not None:
-        ax.plot(x, _db(Y_time), "x", ms=3, alpha=0.6, label=labels[1])
+        ax.plot(x, _db(Y_time), "o", ms=4.5, mfc="none", mew=0.8, color="C1", label=labels[1])
+    ax.plot(x, _db(Y_fds), ".", ms=3, color="C0", zorder=3, label=labels[0])
+    if Y_time is not None:
         ax.plot(x, _db(np.asarray(Y_fds) - np.asarray(Y_time)), ".", ms=2, color="C3",
                 label=f"|{labels[0]} - {labels[1]}|")
-    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("amplitude (dB)")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    handles, names = ax.get_legend_handles_labels()
+    order = sorted(range(len(names)), key=lambda i: names[i] != labels[0])
+    ax.legend([handles[i] for i in order], [names[i] for i in order])
     return ax
 
 
 def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zeros_est=None, *,
-                       ax=None, zoom_on_poles=False):
-    """Frozen (instantaneous) poles and zeros over a period, true and estimated (paper Figs. 3, 5)."""
+                       ax=None, zoom_on_poles=False, discrete=False, equal_aspect=None):
+    """Frozen (instantaneous) poles and zeros over a period, true and estimated (paper Figs. 3, 5).
+
+    Continuous time: the s-plane, both axes in rad/s. ``discrete=True``: the z-plane (unitless),
+    with the unit circle. ``equal_aspect`` draws both axes on the same scale (so a damping ratio
+    reads off as an angle); by default it is on unless the curves are far wider than tall (the
+    paper's Fig. 3), and always on in the z-plane.
+    """
     ax = _axes(ax)
     style = {"true": dict(lw=2.0, alpha=0.5), "est": dict(lw=1.0, ls="--")}
+    drawn = []
     def curves(arr, marker, color, label, kind):
         if arr is None:
             return
-        arr = np.asarray(arr)
+        arr = np.atleast_2d(np.asarray(arr))
+        drawn.append(arr[np.isfinite(arr)])
         for j in range(arr.shape[1]):
-            ax.plot(arr[:, j].real, arr[:, j].imag, color=color,
-                    label=label if j == 0 else None, **style[kind])
-            ax.plot(arr[0, j].real, arr[0, j].imag, marker, color=color, ms=6, mfc="none")
+            ax.plot(arr[:, j].real, arr[:, j].imag, color=color, **style[kind])
+            ax.plot(arr[0, j].real, arr[0, j].imag, marker, color=color, ms=7, mfc="none", mew=1.2)
+        # the legend shows what is drawn: the curve (time-varying roots) and the marker at t = 0
+        if arr.size == 0:
+            return
+        with np.errstate(invalid="ignore"):
+            moving = arr.shape[0] > 1 and bool(np.any(np.abs(np.ptp(arr, axis=0)) > 1e-9 * (1 + np.abs(arr[0]))))
+        ax.plot([], [], marker=marker, color=color, ms=7, mfc="none", mew=1.2, label=label,
+                **(style[kind] if moving else dict(ls="none")))
     curves(poles_true, "x", "C0", "poles, true", "true")
     curves(poles_est, "x", "C3", "poles, estimated", "est")
     if not zoom_on_poles:
         curves(zeros_true, "o", "C2", "zeros, true", "true")
         curves(zeros_est, "o", "C1", "zeros, estimated", "est")
-    ax.set_xlabel("real part")
-    ax.set_ylabel("imaginary part")
+    if discrete:
+        th = np.linspace(0, 2 * np.pi, 361)
+        ax.plot(np.cos(th), np.sin(th), color="0.5", lw=0.8, label="unit circle")
+        ax.set_xlabel("real part (z-plane, unitless)")
+        ax.set_ylabel("imaginary part (z-plane, unitless)")
+    else:
+        ax.set_xlabel("real part (rad/s)")
+        ax.set_ylabel("imaginary part (rad/s)")
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.axvline(0.0, color="0.6", lw=0.6)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     if zoom_on_poles and poles_true is not None:
@@ -78,31 +114,49 @@ def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zero
         pad = 0.15 * max(np.ptp(sel.real), np.ptp(sel.imag), 1e-3)
         ax.set_xlim(sel.real.min() - pad, sel.real.max() + pad)
         ax.set_ylim(sel.imag.min() - pad, sel.imag.max() + pad)
+    elif equal_aspect is None:
+        pts = np.concatenate(drawn) if drawn else np.zeros(0)
+        wide = pts.size and np.ptp(pts.real) > 8 * max(np.ptp(pts.imag), 1e-12) and np.ptp(pts.imag) > 0
+        equal_aspect = discrete or not wide
+    if zoom_on_poles and equal_aspect is None:
+        equal_aspect = True
+    if equal_aspect:
+        # with the zoom's fixed limits the box adapts; otherwise the limits do
+        ax.set_aspect("equal", adjustable="box" if zoom_on_poles else "datalim")
     return ax
 
 
-def prediction_error(lines, noise_std, error, *, w0=None, ax=None, mean_noise_std=None):
-    """Output-noise standard deviation against |true - predicted output| per line (paper Fig. 4)."""
+def prediction_error(lines, noise_std, error, *, w0=None, ax=None, mean_noise_std=None, hz=False):
+    """Output-noise standard deviation against |true - predicted output| per line (paper Fig. 4);
+    against frequency l * w0 in rad/s (or Hz with ``hz``) when ``w0`` is given."""
     ax = _axes(ax)
-    lines = np.asarray(lines)
-    x = lines * w0 if w0 else lines
+    x, xlabel = _freq_axis(lines, w0, hz)
     ax.plot(x, _db(noise_std), "-", color="C0", label="output noise std (one period)")
     if mean_noise_std is not None:
         ax.plot(x, _db(mean_noise_std), "-", color="C0", alpha=0.4, label="std of the mean of P periods")
     ax.plot(x, _db(error), ".", ms=3, color="C3", label="|true - predicted output|")
-    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("amplitude (dB)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     return ax
 
 
-def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=None):
-    """Normalised residue |e_l| / sqrt(var e_l) per line in dB with the 0 dB line (paper Fig. 6)."""
+def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=None, hz=False,
+                       excited=None):
+    """Normalised residue |e_l| / sqrt(var e_l) per line in dB with the 0 dB line (paper Fig. 6);
+    against frequency l * w0 in rad/s (or Hz with ``hz``) when ``w0`` is given. ``excited``: the
+    lines to mark (those the verdict judges), drawn on top in another colour."""
     ax = _axes(ax)
-    lines = np.asarray(lines)
-    x = lines * w0 if w0 else lines
-    ax.plot(x, _db(r), ".", ms=4, color="C0")
+    x, xlabel = _freq_axis(lines, w0, hz)
+    if excited is None:
+        ax.plot(x, _db(r), ".", ms=4, color="C0")
+    else:
+        on = np.isin(np.asarray(lines), np.asarray(excited))
+        ax.plot(x[~on], _db(np.asarray(r)[~on]), ".", ms=3, color="0.6", label="other lines of the fit")
+        ax.plot(x[on], _db(np.asarray(r)[on]), "o", ms=4, color="C0", zorder=3,
+                label="excited lines (judged by the verdict)")
+        ax.legend(fontsize="small")
     ax.axhline(0.0, color="k", lw=1)
     title = []
     if fraction is not None:
@@ -111,44 +165,61 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
         title.append(f"expected {100 * expected:.1f} %")
     if title:
         ax.set_title(", ".join(title))
-    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("normalised residue (dB)")
     ax.grid(True, alpha=0.3)
     return ax
 
 
-def coefficients(t, true=None, est=None, *, names=None, ax=None):
-    """Coefficient trajectories a_n(t) / b_m(t) over time, true (wide, pale) and estimated (dashed)."""
+def coefficients(t, true=None, est=None, *, names=None, ax=None, ylabel="coefficient value"):
+    """Coefficient trajectories a_n(t) / b_m(t) over time, true (wide, pale) and estimated (dashed).
+
+    One colour per coefficient; the legend names the coefficients by colour and, when both are
+    drawn, the line styles of true and estimated.
+    """
+    from matplotlib.lines import Line2D
+
     ax = _axes(ax)
     styles = {"true": dict(ls="-", lw=3.0, alpha=0.35), "estimated": dict(ls="--", lw=1.2)}
-    for arr, lab in ((true, "true"), (est, "estimated")):
-        if arr is None:
-            continue
-        arr = np.asarray(arr)
+    drawn = [(np.asarray(arr), lab) for arr, lab in ((true, "true"), (est, "estimated")) if arr is not None]
+    n = max((arr.shape[1] for arr, _ in drawn), default=0)
+    label = [names[j] if names else f"c{j}" for j in range(n)]
+    if len(drawn) == 1:  # one kind: plain lines, as the legend shows them
+        styles[drawn[0][1]] = dict(ls="-", lw=1.6)
+    for arr, lab in drawn:
         for j in range(arr.shape[1]):
-            name = names[j] if names else f"c{j}"
-            ax.plot(t, arr[:, j], color=f"C{j}", label=f"{name} {lab}", **styles[lab])
+            ax.plot(t, arr[:, j], color=f"C{j % 10}", **styles[lab])
+    handles = [Line2D([], [], color=f"C{j % 10}", lw=1.6, label=label[j]) for j in range(n)]
+    if len(drawn) > 1:
+        handles += [Line2D([], [], color="0.3", label=lab, **styles[lab]) for _, lab in drawn]
+    elif drawn:
+        ax.set_title(f"{drawn[0][1]} coefficients over one period")
     ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="small")
+    if handles:
+        ax.legend(handles=handles, fontsize="small", ncol=2 if n > 4 else 1)
     return ax
 
 
-def model_fit(lines, Y, Y_model, noise_std=None, *, w0=None, ax=None):
-    """Measured output spectrum, the model's output, their difference and the noise level (dB)."""
+def model_fit(lines, Y, Y_model, noise_std=None, *, w0=None, ax=None, hz=False):
+    """Measured output spectrum, the model's output, their difference and the noise level (dB),
+    against frequency l * w0 in rad/s (or Hz with ``hz``) when ``w0`` is given. The model is drawn
+    as open circles under the measured points, so the data stay visible."""
     ax = _axes(ax)
-    lines = np.asarray(lines)
-    x = lines * w0 if w0 else lines
+    x, xlabel = _freq_axis(lines, w0, hz)
     Y, Y_model = np.asarray(Y), np.asarray(Y_model)
-    ax.plot(x, _db(Y), ".", ms=3, label="measured output |Y| (mean of the periods)")
-    ax.plot(x, _db(Y_model), "x", ms=3, label="model output from the measured input")
-    ax.plot(x, _db(Y - Y_model), ".", ms=3, label="difference Y - Y_model")
     if noise_std is not None:
-        ax.plot(x, _db(noise_std), "-", label="noise std of the mean output")
-    ax.set_xlabel("angular frequency (rad/s)" if w0 else "line")
+        ax.plot(x, _db(noise_std), "-", color="0.55", lw=1.0, label="noise std of the mean output")
+    ax.plot(x, _db(Y - Y_model), ".", ms=2.5, color="C3", alpha=0.7, label="difference |Y - Y_model|")
+    ax.plot(x, _db(Y_model), "o", ms=5, mfc="none", mew=0.8, color="C1",
+            label="model output from the measured input")
+    ax.plot(x, _db(Y), ".", ms=3, color="C0", zorder=3, label="measured output |Y| (mean of the periods)")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("amplitude (dB)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="small")
+    handles, labels = ax.get_legend_handles_labels()
+    ax.legend(handles[::-1], labels[::-1], fontsize="small")
     return ax
 
 

@@ -323,3 +323,41 @@ def test_command_without_arguments_prints_help_and_version(capsys):
     with pytest.raises(SystemExit) as e:
         cli.main(["--version"])
     assert e.value.code == 0 and capsys.readouterr().out.startswith("lptv ")
+
+
+@pytest.mark.parametrize("command", ["identify", "demo", "montecarlo", "select"])
+def test_every_subcommand_has_a_description_and_examples(command, capsys):
+    with pytest.raises(SystemExit) as e:
+        cli.main([command, "--help"])
+    out = capsys.readouterr().out
+    assert e.value.code == 0 and out.startswith(f"usage: lptv {command}")
+    head, _, examples = out.partition("\nexamples:\n")
+    assert examples.count(f"lptv {command}") >= 2
+    assert len(head.split("options:")[0].split("\n\n", 1)[1]) > 80  # a description, not only usage
+
+
+def _without_matplotlib(tmp_path, *argv):
+    """Runs the command in a fresh interpreter where matplotlib cannot be imported."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.modules['matplotlib'] = None; from lptv.apps import cli; "
+            f"sys.exit(cli.main({[str(a) for a in argv]!r}))")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,
+                          env=env, timeout=300)
+
+
+def test_a_missing_plots_extra_is_one_line_naming_it(record, tmp_path):
+    r = _without_matplotlib(tmp_path, "demo", "--out", tmp_path / "d")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip().count("\n") == 0 and "pip install 'lptv[plots]'" in r.stderr
+    assert not (tmp_path / "d").exists()
+    u, y = record
+    src = write_csv(tmp_path / "r.csv", u.ravel(), y.ravel())
+    r = _without_matplotlib(tmp_path, "identify", src, "--na", 2, "--nb", 0, "--fs", FS, "--period", T0,
+                            "--out", tmp_path / "o")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip().count("\n") == 0 and "pip install 'lptv[plots]'" in r.stderr
+    assert "verdict:" in r.stdout and (tmp_path / "o" / "model.json").exists()

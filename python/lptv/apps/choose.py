@@ -16,6 +16,7 @@ Example (the paper's simulation example as a measurement file)::
 """
 from __future__ import annotations
 
+import argparse
 import csv
 import re
 import sys
@@ -49,7 +50,13 @@ def add_parser(sub):
         "select", help="choose the orders and harmonic count of a model from a measurement file",
         description="Fits a grid of structures (na, nb, k harmonics on every coefficient) by WGTLS, "
                     "the best per k again by SML, ranks them by MDL (or AIC) with the residue test "
-                    "first, and writes the ranking and the chosen model.")
+                    "first, and writes the ranking (selection.csv), the chosen model.json and "
+                    "summary.json into --out; exit status 1 when every candidate fails the residue test.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="examples:\n"
+               "  lptv select meas.npz --na 1-3 --nb 0-2 --k 0-4\n"
+               "  lptv select record.csv --periods 8 --period 10 --na 1-3 --nb 0-2 --k 0 --criterion aic\n"
+               "  lptv select meas.npz --na 2 --nb 1 --k 0-4 --workers 2")
     p.add_argument("file", metavar="FILE", help="measurements: .csv, .npz or .mat (as for lptv identify)")
     p.add_argument("--na", default="1-3", help="orders of the output side to try (default 1-3)")
     p.add_argument("--nb", default="0-2", help="orders of the input side to try (default 0-2)")

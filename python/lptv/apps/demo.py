@@ -170,10 +170,10 @@ def run(args) -> int:
         "frequency domain, measured over P noisy periods, and identified from data where both input "
         "and output are noisy. Every choice is stated in lptv.examples and lptv.apps.demo; every random "
         f"number comes from seed {seed}.")
-    rep.table(["quantity", "value"], [[k, v] for k, v in summary.items() if k != "monte_carlo"])
+    rep.table(["quantity", "value"], _summary_rows(summary))
     rep.heading("Simulation: FDS against time integration")
     n_plot = 300
-    ax = plots.output_spectrum(np.arange(n_plot), Y_fds[:n_plot], Y_cvode[:n_plot])
+    ax = plots.output_spectrum(np.arange(n_plot), Y_fds[:n_plot], Y_cvode[:n_plot], w0=model.w0)
     rep.figure(ax.figure, "fig2_fds_vs_cvode.png",
                f"Output spectrum by the frequency-domain simulator and by CVODE (shooting to the periodic "
                f"steady state), and their difference: the worst line is {-fds_vs_cvode_db:.0f} dB below "
@@ -185,24 +185,24 @@ def run(args) -> int:
     t = np.linspace(0, model.period, 400)
     pt, zt = frozen_poles(model, t), frozen_zeros(model, t)
     pe, ze = frozen_poles(wg.model, t), frozen_zeros(wg.model, t)
-    ax = plots.frozen_poles_zeros(t, pt, zt, pe, ze)
+    ax = plots.frozen_poles_zeros(t, pt, zt, pe, ze, discrete=model.discrete)
     rep.figure(ax.figure, "fig3_frozen_poles_zeros.png",
                "Frozen (instantaneous) poles and zeros over one period, true (solid) and estimated by "
                "WGTLS (dashed); markers at t = 0. They trace closed curves and say nothing about "
                f"stability; Floquet theory does: the characteristic multipliers have spectral radius "
                f"{fl_true.spectral_radius:.2g} (true model) and {fl_est.spectral_radius:.2g} (WGTLS), so the "
                f"identified periodic system is {'stable' if fl_est.is_stable else 'NOT stable'}. Paper: Fig. 3.")
-    ax = plots.prediction_error(lines, noise_std, err, mean_noise_std=mean_noise_std)
+    ax = plots.prediction_error(lines, noise_std, err, mean_noise_std=mean_noise_std, w0=model.w0)
     rep.figure(ax.figure, "fig4_prediction_error.png",
                f"Standard deviation of one period's output noise and of the mean of the {P} periods, "
                f"against the error of the output predicted by the FDS with the WGTLS estimate and the "
                f"noise-free input: on average {below:.1f} dB below one period's noise "
                f"({below_mean:.1f} dB below that of the mean). Paper: Fig. 4 (about 15 dB).")
-    ax = plots.frozen_poles_zeros(t, pt, None, pe, None, zoom_on_poles=True)
+    ax = plots.frozen_poles_zeros(t, pt, None, pe, None, zoom_on_poles=True, discrete=model.discrete)
     rep.figure(ax.figure, "fig5_frozen_poles_zoom.png",
                "Zoom on the frozen poles in the upper half plane: true against estimated. Paper: Fig. 5.")
     ax = plots.normalized_residue(lines, wg.normalized_residue, fraction=wg.fraction_above_0db,
-                                  expected=wg.fraction_expected)
+                                  expected=wg.fraction_expected, w0=model.w0)
     rep.figure(ax.figure, "fig6_normalized_residue.png",
                f"Normalised residue |e_l| / sqrt(var e_l) of the WGTLS estimate per line: "
                f"{100 * wg.fraction_above_0db:.1f} % lie above 0 dB against {100 * wg.fraction_expected:.1f} % "
@@ -241,6 +241,36 @@ def run(args) -> int:
     wg.model.save(out / "model_wgtls.json")
     _say(f"  done in {time.perf_counter() - t_start:.1f} s: {out / 'report.html'}, {out / 'summary.json'}")
     return 0
+
+
+def _summary_rows(s):
+    """The summary as labelled rows with their units (summary.json keeps the raw keys)."""
+    lo, hi = s["fraction_band"]
+    return [
+        ["seed of every random number", s["seed"]],
+        ["measured periods P; lines of the fit", f"{s['periods']}; {s['n_lines']}"],
+        ["free parameters", s["n_free_parameters"]],
+        ["SNR of the input, of the output", f"{s['snr_in_db']:g} dB, {s['snr_out_db']:g} dB"],
+        ["FDS against CVODE, worst line (below the output peak)", f"{s['fds_vs_cvode_db']:.1f} dB"],
+        ["time of the FDS, of CVODE (this run)",
+         f"{1e3 * s['fds_seconds']:.2f} ms, {1e3 * s['cvode_seconds']:.0f} ms "
+         f"({s['fds_speedup_vs_cvode']:.0f} x faster)"],
+        ["relative parameter error: TLS, WGTLS, SML",
+         f"{s['tls_rel_error']:.4f}, {s['wgtls_rel_error']:.4f}, {s['sml_rel_error']:.4f}"],
+        ["WGTLS iterations, converged, cost",
+         f"{s['wgtls_iterations']}, {s['wgtls_converged']}, {s['wgtls_cost']:.3f}"],
+        ["SML: true parameters within 2 std", f"{100 * s['sml_within_2_sigma']:.0f} %"],
+        ["SML std / Cramer-Rao bound (median)", f"{s['sml_std_over_crb_median']:.2f}"],
+        ["WGTLS residues above 0 dB",
+         f"{100 * s['fraction_above_0db']:.1f} % (expected {100 * s['fraction_expected']:.1f} %, "
+         f"band {100 * lo:.1f}-{100 * hi:.1f} %)"],
+        ["prediction error below the output noise: one period, the mean",
+         f"{s['prediction_below_noise_db']:.1f} dB, {s['prediction_below_mean_noise_db']:.1f} dB"],
+        ["Floquet spectral radius: true, WGTLS (unitless; < 1 is stable)",
+         f"{s['floquet_spectral_radius_true']:.3g}, {s['floquet_spectral_radius_wgtls']:.3g}"],
+        ["Floquet spectral radius of the damped Mathieu equation",
+         f"{s['mathieu_floquet_spectral_radius']:.4f}"],
+    ]
 
 
 def _eta_of(model, names):

@@ -138,8 +138,11 @@ def add_parser(sub):
     p = sub.add_parser(
         "identify", help="identify an LPTV model from a measurement file (CSV, NPZ, MAT)",
         description=_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog="examples: lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
-               "          lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2")
+        epilog="examples:\n"
+               "  lptv identify record.csv --fs 100 --period 10 --na 2 --nb 0 --method sml\n"
+               "  lptv identify record.csv --fs 100 --period 10 --trim --skip-periods 1 --na 2 --nb 0\n"
+               "  lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
+               "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2")
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurements: .csv, .npz or .mat; several files are fitted as a batch")
     p.add_argument("--na", type=int, required=True, help="order of the output side")
@@ -250,7 +253,7 @@ def run(args) -> int:
     except OSError as e:
         return _fail(e.filename or out, e.strerror or e)
     except ImportError:
-        return _fail(src, "writing report.html needs matplotlib (pip install 'lptv[plots]')")
+        return _fail(src, "writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'")
     print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
     return 0
 
@@ -333,34 +336,48 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
         ["output residue against the noise", "-" if gap is None else f"{gap:+.1f} dB"],
     ])
 
-    ax = plots.normalized_residue(rows, res.normalized_residue, fraction=res.fraction_above_0db,
-                                  expected=res.fraction_expected)
+    vlo, vhi = res.verdict_band
+    ax = plots.normalized_residue(rows, res.normalized_residue, w0=model.w0, excited=res.verdict_lines)
+    ax.set_title(f"excited lines: {100 * res.verdict_fraction:.1f} % above 0 dB "
+                 f"(band {100 * vlo:.1f}-{100 * vhi:.1f} %); all lines: {100 * res.fraction_above_0db:.1f} %",
+                 fontsize="medium")
     rep.figure(ax.figure, "normalized_residue.png",
-               f"Normalised residue |e_l| / sqrt(var e_l) per line against 0 dB: "
-               f"{100 * res.fraction_above_0db:.1f} % of the lines lie above, where noise alone gives "
-               f"{100 * res.fraction_expected:.1f} % (band {100 * lo:.1f}-{100 * hi:.1f} %); "
-               + ("the fit shows no sign of modelling errors." if res.residue_ok else
-                  "outside that band the residue holds more than noise: check the orders and harmonics."))
+               f"Normalised residue |e_l| / sqrt(var e_l) against frequency with the 0 dB line. On the "
+               f"{res.verdict_lines.size} excited lines, which the verdict judges, "
+               f"{100 * res.verdict_fraction:.1f} % lie above 0 dB, where noise alone gives "
+               f"{100 * vlo:.1f}-{100 * vhi:.1f} %; on all {rows.size} lines of the fit "
+               f"{100 * res.fraction_above_0db:.1f} % (expected {100 * res.fraction_expected:.1f} %, band "
+               f"{100 * lo:.1f}-{100 * hi:.1f} %). "
+               + ("The fit shows no sign of modelling errors." if res.model_ok else
+                  "The model is rejected: " + "; ".join(res.model_errors) + "."))
 
     t = np.linspace(0.0, model.period, 400)
-    ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t))
-    rep.figure(ax.figure, "frozen_poles_zeros.png",
-               "Frozen (instantaneous) poles and zeros of the estimate over one period, markers at "
-               f"t = 0 ({'z' if model.discrete else 's'}-plane). They show how the system varies "
-               "and say nothing about the stability of the time-varying system.")
+    ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
+                                  discrete=model.discrete)
+    if model.is_lti:
+        rep.figure(ax.figure, "frozen_poles_zeros.png",
+                   "Poles (x) and zeros (o) of the LTI model, "
+                   + ("in the z-plane (unitless) with the unit circle." if model.discrete else
+                      "in the s-plane (rad/s), both axes on the same scale."))
+    else:
+        rep.figure(ax.figure, "frozen_poles_zeros.png",
+                   "Frozen (instantaneous) poles and zeros of the estimate over one period, markers at "
+                   "t = 0 " + ("(z-plane, unitless, with the unit circle)" if model.discrete else "(s-plane, rad/s)")
+                   + ". They show how the system varies and say nothing about the stability of the "
+                   "time-varying system.")
 
-    ax = plots.model_fit(rows, d.Y[rows], Y_pred[rows], np.sqrt(d.varY[rows]))
+    ax = plots.model_fit(rows, d.Y[rows], Y_pred[rows], np.sqrt(d.varY[rows]), w0=model.w0)
     rep.figure(ax.figure, "output_spectrum.png",
-               "Measured output spectrum, the output the model predicts from the measured input, their "
-               f"difference and the noise standard deviation of the mean of the {P} periods (one "
-               f"period's is sqrt({P}) larger). "
+               "Measured output spectrum (dots), the output the model predicts from the measured input "
+               "(open circles), their difference and the noise standard deviation of the mean of the "
+               f"{P} periods (one period's is sqrt({P}) larger). "
                + (f"The difference is on average {gap:+.1f} dB from the noise level; a good model keeps "
                   "it near the noise (the measured input is noisy too), far below |Y| on the excited lines."
                   if gap is not None else ""))
 
     names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
     coef = np.hstack([model.a_at(t), model.b_at(t)]).real
-    ax = plots.coefficients(t, est=coef, names=names)
+    ax = plots.coefficients(t, est=coef, names=names, ylabel="a_n(t), b_m(t)")
     rep.figure(ax.figure, "coefficients.png",
                "The estimated coefficients a_n(t) and b_m(t) over one period (normalised so that "
                "the mean of a_na is 1, unless coefficients were given as known).")

@@ -16,6 +16,7 @@ Example::
 """
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -34,8 +35,15 @@ def add_parser(sub):
     p = sub.add_parser(
         "montecarlo", help="Monte Carlo study of the estimators (bias, variance / CRB, coverage)",
         description="R noise realisations of a design, each fitted by the given methods; the "
-                    "paper's example unless --model is given. Results are the same whatever the "
-                    "executor and the number of workers.")
+                    "paper's example unless --model is given (then a random-phase multisine on "
+                    "--excited lines). Results are the same whatever the executor and the number of "
+                    "workers. Writes report.html (needs matplotlib: pip install 'lptv[plots]'), the "
+                    "estimates, fits and summaries as CSV or Parquet, and summary.json into --out.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="examples:\n"
+               "  lptv montecarlo --runs 200 --method wgtls,sml --workers 2\n"
+               "  lptv montecarlo --runs 2000 --method wgtls --scheduler tcp://10.0.0.5:8786\n"
+               "  lptv montecarlo --model model.json --excited 1-60 --samples 1024 --snr-out 20")
     p.add_argument("--runs", type=int, default=200, metavar="R", help="realisations (default 200)")
     p.add_argument("--periods", type=int, default=8, metavar="P", help="measured periods (default 8)")
     p.add_argument("--method", default="wgtls", metavar="M[,M...]",

@@ -73,8 +73,8 @@ class Report:
             (out / name).write_bytes(data)
         style = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}"
                  "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:.2em .6em;"
-                 "text-align:right}th{background:#eee}figure{margin:1.5em 0}img{max-width:100%}"
-                 "figcaption{font-size:.92em;color:#444}pre{background:#f6f6f6;padding:.6em}")
+                 "text-align:right}td:first-child{text-align:left}th{background:#eee}figure{margin:1.5em 0}img{max-width:100%}"
+                 "figcaption{font-size:.92em;color:#444}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap}")
         page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(self.title)}"
                 f"</title><style>{style}</style></head><body><h1>{html.escape(self.title)}</h1>"
                 + "\n".join(self._parts) + "</body></html>")
