@@ -21,6 +21,19 @@ int Grid::index_of(int line) const {
   return (line < -L || line > L) ? -1 : line + L;
 }
 
+// The grid -L..L in 64-bit arithmetic: 2 L + 1 and the guard grown on top of it must stay ints,
+// and the factors must fit in memory; refuse before anything is allocated.
+static void check_grid_size(long long L, int K) {
+  constexpr long long kMaxLines = 1LL << 26;  // 2 (L + guard) + 1 stays far below INT_MAX
+  if (L > kMaxLines) {
+    const double gb = (2.0 * static_cast<double>(L) + 1) * 16.0 * (3.0 * K + 4) / 1e9;
+    throw std::invalid_argument("the grid of lines -" + std::to_string(L) + ".." + std::to_string(L) +
+                                " is too large (at most " + std::to_string(kMaxLines) +
+                                " lines each side): its band factors alone would take about " +
+                                std::to_string(static_cast<long long>(gb + 0.5)) + " GB");
+  }
+}
+
 Grid make_grid(const Model& m, int L) {
   Grid g;
   if (m.discrete()) {
@@ -29,6 +42,7 @@ Grid make_grid(const Model& m, int L) {
     g.L = g.N / 2;
   } else {
     if (L < 0) throw std::invalid_argument("L must be >= 0, got " + std::to_string(L));
+    check_grid_size(L, m.kmax());
     g.L = L;
     g.N = 2 * L + 1;
   }
@@ -486,6 +500,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
   // The output beyond the last excited line only decays, so the grid starts there (or at
   // the lines asked for explicitly); trailing zero lines of U cost nothing.
   const int band = std::max(last_nonzero_line(U), opt.lines_out < 0 ? 0 : opt.lines_out);
+  check_grid_size(band, m.kmax());
   const int K = std::max(1, m.kmax());
   // One grid: the wanted lines and a bound on their truncation error. Dropping the lines
   // beyond the grid drops coupling terms no larger than the outermost K computed lines times

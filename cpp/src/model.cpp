@@ -95,6 +95,11 @@ int Model::samples_per_period() const {
   }
   const double N = 2.0 * M_PI / (w0_ * ts_);
   const double Nr = std::round(N);
+  if (!(Nr <= 2147483647.0)) {
+    std::ostringstream msg;
+    msg << "w0 and ts give 2*pi/(w0*ts) = " << N << " samples per parameter period, more than a grid can hold";
+    throw std::invalid_argument(msg.str());
+  }
   if (Nr < 1 || std::abs(N - Nr) > 1e-9 * Nr) {
     std::ostringstream msg;
     msg << "w0 and ts do not fit a grid: 2*pi/(w0*ts) = " << N

@@ -107,6 +107,9 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     return Y
 
 
+MAX_GRID_LINES = 2 ** 26
+
+
 def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str = "auto"):
     """Columns of the truncated harmonic transfer function G = A^-1 B.
 
@@ -124,7 +127,9 @@ def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str
     G : ndarray (grid size, len(lines)); row i is output line i - L (continuous) or i (discrete).
     """
     _check_model(model)
-    L = as_int(L, "L")
+    # the core's largest grid (2^26 lines each side): checked here too, before the default list
+    # of 2 L + 1 input lines below is built
+    L = as_int(L, "L", maximum=MAX_GRID_LINES)
     solver = as_str(solver, "solver", SOLVERS)
     n = model.samples_per_period if model.discrete else 2 * L + 1
     if lines is None:

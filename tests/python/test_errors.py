@@ -404,3 +404,18 @@ def test_a_parametrisation_beyond_the_size_limit_says_how_much_memory():
 
     with pytest.raises(ValueError, match="complex parameters .* GB"):
         _core.Parametrisation(2, 0, [1500, 1500, 1500], [0], [], 0.1, 0.0)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda M: lptv.htf(M, 2**30), "L must be at most 67108864"),
+    (lambda M: lptv.band_matrices(M, 2**31 - 1), "too large .* GB"),
+    (lambda M: lptv.simulate(M, np.ones(10), lines_out=2**31 - 2), "too large .* GB"),
+    (lambda M: lptv.Model([[1.0], [1.0]], [[1.0]], w0=1e-9, ts=0.73).samples_per_period,
+     "more than a grid can hold"),
+])
+def test_grids_beyond_int_range_are_refused_before_allocating(call, match):
+    """2 L + 1 and the guard on top of a grid are ints in the core, and 8.6e9 samples per period
+    were cast to int: each is now a ValueError before anything is allocated."""
+    M = lptv.Model([[1.0, 2.0, 1.0], [0.0, 1.0, 0.0]], [[0.0, 1.0, 0.0]], w0=0.1)
+    with pytest.raises(ValueError, match=match):
+        call(M)
