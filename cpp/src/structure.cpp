@@ -25,6 +25,17 @@ int Structure::kmax() const {
   return k;
 }
 
+Structure Structure::of(const Model& m) {
+  Structure s;
+  s.na = m.na();
+  s.nb = m.nb();
+  s.ka.assign(s.na + 1, m.ka());
+  s.kb.assign(s.nb + 1, m.kb());
+  s.w0 = m.w0();
+  s.ts = m.ts();
+  return s;
+}
+
 long long Structure::n_complex_parameters() const {
   long long n = 0;
   for (int v : ka) n += 2LL * v + 1;

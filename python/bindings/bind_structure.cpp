@@ -1,3 +1,4 @@
+#include "lptv/model.hpp"
 #include "lptv/structure.hpp"
 #include "pybind11.hpp"
 
@@ -31,7 +32,8 @@ void bind_structure(py::module_& m) {
       .def_readonly("kb", &lptv::Structure::kb)
       .def_readonly("w0", &lptv::Structure::w0)
       .def_readonly("ts", &lptv::Structure::ts)
-      .def_property_readonly("kmax", &lptv::Structure::kmax);
+      .def_property_readonly("kmax", &lptv::Structure::kmax)
+      .def_static("of", &lptv::Structure::of, "model"_a, "The model's own orders and harmonic counts.");
 
   py::class_<lptv::Parametrisation>(m, "Parametrisation")
       .def(py::init([](int na, int nb, std::vector<int> ka, std::vector<int> kb, const KnownList& known,

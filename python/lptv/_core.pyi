@@ -84,6 +84,11 @@ class Structure:
     """
     Orders, harmonic counts per coefficient, known coefficients, w0 and ts.
     """
+    @staticmethod
+    def of(model: Model) -> Structure:
+        """
+        The model's own orders and harmonic counts.
+        """
     def __init__(self, na: typing.SupportsInt | typing.SupportsIndex, nb: typing.SupportsInt | typing.SupportsIndex, ka: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], kb: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], known: collections.abc.Sequence[tuple[bool, typing.SupportsInt | typing.SupportsIndex, typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]]], w0: typing.SupportsFloat | typing.SupportsIndex, ts: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         ...
     @property

@@ -9,9 +9,7 @@ from .model import Model
 
 
 def _structure_of(model: Model):
-    return _core.Parametrisation(model.na, model.nb, [model.ka] * (model.na + 1),
-                                 [model.kb] * (model.nb + 1), [], model.w0,
-                                 0.0 if model.ts is None else model.ts)
+    return _core.Parametrisation(_core.Structure.of(model._cpp))
 
 
 def normalized_residue(model: Model, data, lines, *, _par=None, _theta=None):

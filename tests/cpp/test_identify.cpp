@@ -34,16 +34,6 @@ lptv::FrequencyData noiseless(const lptv::Model& m, int L, unsigned seed) {
   return d;
 }
 
-lptv::Structure structure_of(const lptv::Model& m) {
-  lptv::Structure s;
-  s.na = m.na();
-  s.nb = m.nb();
-  s.ka.assign(s.na + 1, m.ka());
-  s.kb.assign(s.nb + 1, m.kb());
-  s.w0 = m.w0();
-  return s;
-}
-
 }  // namespace
 
 TEST_CASE("GSVD pairs satisfy the defining ratio", "[gsvd]") {
@@ -81,7 +71,7 @@ TEST_CASE("GSVD handles a singular B (infinite pairs)", "[gsvd]") {
 TEST_CASE("every estimator recovers a noise-free LPTV model", "[estimators]") {
   const lptv::Model m = lptv_model();
   const lptv::FrequencyData d = noiseless(m, 60, 1);
-  lptv::Parametrisation p(structure_of(m));
+  lptv::Parametrisation p(lptv::Structure::of(m));
   const auto rows = lptv::default_rows(p, d.max_line());
   for (auto method : {lptv::Method::LS, lptv::Method::TLS, lptv::Method::GTLS, lptv::Method::WGTLS}) {
     lptv::EstimateOptions opt;
@@ -96,7 +86,7 @@ TEST_CASE("every estimator recovers a noise-free LPTV model", "[estimators]") {
 TEST_CASE("the residue of the true model vanishes on noise-free data", "[jacobian]") {
   const lptv::Model m = lptv_model();
   const lptv::FrequencyData d = noiseless(m, 40, 2);
-  lptv::Parametrisation p(structure_of(m));
+  lptv::Parametrisation p(lptv::Structure::of(m));
   const auto rows = lptv::default_rows(p, d.max_line());
   Eigen::VectorXcd theta(p.n_theta());
   for (int q = 0; q < p.n_theta(); ++q) {
@@ -116,7 +106,7 @@ TEST_CASE("the FDS and the row kernels build bitwise identical band entries", "[
   const lptv::Model dt(a_dt, ct.b(), 2 * M_PI / 64, 1.0);
   for (const lptv::Model& m : {ct, dt}) {
     const lptv::FrequencyData d = noiseless(m, 30, 4);
-    lptv::Structure s = structure_of(m);
+    lptv::Structure s = lptv::Structure::of(m);
     s.ts = m.ts();
     const lptv::Parametrisation p(s);
     const auto rows = lptv::default_rows(p, d.max_line());
@@ -148,7 +138,7 @@ TEST_CASE("the FDS and the row kernels build bitwise identical band entries", "[
 TEST_CASE("rows that need missing lines are refused", "[jacobian]") {
   const lptv::Model m = lptv_model();
   const lptv::FrequencyData d = noiseless(m, 20, 3);
-  lptv::Parametrisation p(structure_of(m));
+  lptv::Parametrisation p(lptv::Structure::of(m));
   REQUIRE_THROWS_AS(lptv::check_rows(p, {19, 20}, d.max_line()), std::invalid_argument);
   REQUIRE_THROWS_AS(lptv::check_rows(p, {0, 2}, d.max_line()), std::invalid_argument);
   REQUIRE_THROWS_AS(lptv::check_rows(p, {2, 3}, d.max_line()), std::invalid_argument);  // too few

@@ -28,16 +28,6 @@ lptv::Model model(int K) {
   return lptv::Model(a, b, 0.1);
 }
 
-lptv::Structure structure_of(const lptv::Model& m) {
-  lptv::Structure s;
-  s.na = m.na();
-  s.nb = m.nb();
-  s.ka.assign(s.na + 1, m.ka());
-  s.kb.assign(s.nb + 1, m.kb());
-  s.w0 = m.w0();
-  return s;
-}
-
 // Steady-state spectra of every line 1..L excited, with circular complex noise of variance
 // sigma2 on U and Y (correlated with coefficient rho) and the matching statistics; DC real.
 lptv::FrequencyData noisy(const lptv::Model& m, int L, double sigma2, double rho, std::mt19937& gen,
@@ -76,7 +66,7 @@ TEST_CASE("exact cost: the gradient matches central differences", "[likelihood]"
   for (int K : {0, 1}) {
     const lptv::Model m = model(K);
     const lptv::FrequencyData d = noisy(m, 40, 1e-3, 0.3, gen);
-    const lptv::Parametrisation p(structure_of(m));
+    const lptv::Parametrisation p(lptv::Structure::of(m));
     // Rows from 1 use the conjugate lines and DC.
     const lptv::ExactLikelihood lik(d, p, rows_from(1, 40 - K));
     Eigen::VectorXd xi = p.xi_from_theta(p.theta_from_model(m));
@@ -98,7 +88,7 @@ TEST_CASE("exact cost: for LTI models it is twice the diagonal SML cost", "[like
   std::mt19937 gen(5);
   const lptv::Model m = model(0);
   const lptv::FrequencyData d = noisy(m, 30, 1e-3, -0.4, gen);
-  const lptv::Parametrisation p(structure_of(m));
+  const lptv::Parametrisation p(lptv::Structure::of(m));
   const auto rows = rows_from(1, 30);
   const lptv::ExactLikelihood lik(d, p, rows);
   const Eigen::VectorXcd theta = p.theta_from_model(m) * 1.02;
@@ -113,7 +103,7 @@ TEST_CASE("exact cost: S matches the Monte Carlo covariance of the residue", "[l
   const lptv::Model m = model(1);
   const int L = 12;
   const lptv::FrequencyData d0 = noisy(m, L, 1e-2, 0.5, gen, false);
-  const lptv::Parametrisation p(structure_of(m));
+  const lptv::Parametrisation p(lptv::Structure::of(m));
   const auto rows = rows_from(1, L - 1);  // rows 1 and 2 use line 0 and conjugate lines
   const Eigen::VectorXcd theta = p.theta_from_model(m);
   const Eigen::MatrixXd S = lptv::ExactLikelihood(d0, p, rows).residue_covariance(theta);
@@ -153,7 +143,7 @@ TEST_CASE("identify: every method through one entry point, sml with its covarian
                       lptv::Method::SML}) {
     lptv::IdentifyOptions opt;
     opt.method = method;
-    const lptv::Identification r = lptv::identify(d, structure_of(m), opt);
+    const lptv::Identification r = lptv::identify(d, lptv::Structure::of(m), opt);
     REQUIRE(r.converged);
     REQUIRE(r.eta.size() == static_cast<Eigen::Index>(r.eta_names.size()));
     REQUIRE(r.normalized_residue.size() == static_cast<Eigen::Index>(r.rows.size()));
@@ -161,7 +151,7 @@ TEST_CASE("identify: every method through one entry point, sml with its covarian
     REQUIRE((r.covariance.size() > 0) == has_cov);
     if (method == lptv::Method::SML) {
       // the estimate is within a few standard deviations of the truth
-      const lptv::Parametrisation p(structure_of(m));
+      const lptv::Parametrisation p(lptv::Structure::of(m));
       Eigen::VectorXd truth = p.xi_from_theta(p.theta_from_model(m));
       for (int i = 0; i < r.eta.size(); ++i) {
         const double sd = std::sqrt(r.covariance(i, i));
@@ -179,7 +169,7 @@ TEST_CASE("exact cost: rows without noise are a clear numerical error", "[likeli
   d.varU.setZero();
   d.varY.setZero();
   d.covYU.setZero();
-  const lptv::Parametrisation p(structure_of(m));
+  const lptv::Parametrisation p(lptv::Structure::of(m));
   const lptv::ExactLikelihood lik(d, p, rows_from(2, 19));
   REQUIRE_THROWS_AS(lik.cost(p.theta_from_model(m)), lptv::NumericalError);
 }

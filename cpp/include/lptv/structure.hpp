@@ -27,6 +27,9 @@ struct Structure {
   double ts = 0.0;  // 0: continuous time
 
   int kmax() const;
+  // The structure of a model's own orders and harmonic counts (every a_n with Ka, every b_m
+  // with Kb), nothing known, its w0 and ts.
+  static Structure of(const Model& m);
   // Complex parameters (every harmonic of every coefficient, known ones included) and the free
   // real unknowns after the normalisation, in 64-bit arithmetic (no allocation).
   long long n_complex_parameters() const;
