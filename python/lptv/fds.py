@@ -11,6 +11,7 @@ from . import _core
 from ._validate import as_int, as_positive_float, as_spectrum, as_str
 
 SOLVERS = ("auto", "band", "klu", "umfpack")
+from .floquet import UnstableModelWarning, unstable_warning_text
 from .model import Model
 
 
@@ -42,7 +43,7 @@ def _check_model(model, name="model"):
 
 def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optional[int] = None,
              tol: float = 1e-13, max_guard: Optional[int] = None, solver: str = "auto",
-             full_output: bool = False):
+             full_output: bool = False, warn_unstable: bool = True):
     """Steady-state output spectrum of ``model`` for the input spectrum ``U``.
 
     Solves the band system ``A Y = B U`` (METHOD.md eq. 5) with one sparse LU. The result is
@@ -71,10 +72,27 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
         so 'band' is refused there).
     full_output : bool
         Return a :class:`SimulationResult` instead of ``Y``.
+    warn_unstable : bool
+        Check the model's stability (the roots of a for an LTI model, :func:`lptv.floquet`
+        otherwise; once per model object) and warn when it is unstable. False skips the check.
 
     Returns
     -------
     Y : ndarray, same shape as U (rows up to ``lines_out``)
+
+    Raises
+    ------
+    lptv.NumericalError
+        A is numerically singular: a pole on (or within rounding of) a grid line, or a_na(t)
+        nearly vanishes; the message names the line.
+
+    Warns
+    -----
+    lptv.UnstableModelWarning
+        The model is unstable: the periodic solution is returned, but a simulation from rest
+        never settles into it.
+    TruncationWarning
+        The adaptive guard did not reach ``tol``.
 
     Examples
     --------
@@ -91,6 +109,8 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     max_guard = -1 if max_guard is None else as_int(max_guard, "max_guard")
     tol = as_positive_float(tol, "tol")
     solver = as_str(solver, "solver", SOLVERS)
+    if not isinstance(warn_unstable, (bool, np.bool_)):
+        raise TypeError(f"warn_unstable must be True or False, got {type(warn_unstable).__name__}")
     r = _core.simulate(model._cpp, Ua, solver=solver, lines_out=lines_out, guard=guard, tol=tol,
                        max_guard=max_guard)
     Y = np.asarray(r["Y"])
@@ -101,10 +121,18 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
             f"FDS truncation error {r['truncation_error']:.2e} is above tol={tol:g} "
             f"with {r['guard']} guard lines; pass a larger max_guard or guard",
             TruncationWarning, stacklevel=2)
+    if warn_unstable:
+        _warn_unstable(model)
     if full_output:
         return SimulationResult(Y=Y, guard=r["guard"], truncation_error=r["truncation_error"],
                                 converged=r["converged"], solver=r["solver"])
     return Y
+
+
+def _warn_unstable(model: Model) -> None:
+    text = unstable_warning_text(model)
+    if text is not None:
+        warnings.warn(text, UnstableModelWarning, stacklevel=3)
 
 
 MAX_GRID_LINES = 2 ** 26

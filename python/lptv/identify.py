@@ -11,6 +11,7 @@ import numpy as np
 
 from . import _core
 from .data import FrequencyData, frequency_data_of
+from .floquet import UnstableModelWarning, unstable_warning_text
 from .model import Model
 from ._validate import as_positive_float
 
@@ -67,6 +68,11 @@ class IdentificationResult:
     None for LS, TLS and GTLS."""
     nearly_unidentifiable: bool = False
     """The two smallest generalised singular values are close while the residue test passes."""
+    unstable: Optional[str] = None
+    """A sentence when the identified model is unstable (a Floquet multiplier outside the unit
+    circle; also warned as :class:`lptv.UnstableModelWarning`), None otherwise. Steady-state data
+    of a stabilised experiment identify an unstable system correctly; the sentence says what its
+    predicted output means."""
 
     @property
     def parameter_std(self) -> Optional[np.ndarray]:
@@ -175,7 +181,7 @@ class IdentificationResult:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                Yp = np.asarray(simulate(self.model, self.data.U))
+                Yp = np.asarray(simulate(self.model, self.data.U, warn_unstable=False))
         except Exception:
             return None
         if Yp.shape != self.data.Y.shape:
@@ -243,6 +249,8 @@ class IdentificationResult:
         lines.append(format_parameter_table(self))
         lines.append(f"verdict: {self.verdict}")
         lines += [f"warning: {w}" for w in self.warnings]
+        if self.unstable:
+            lines.append(f"warning: {self.unstable}")
         return "\n".join(lines)
 
 
@@ -415,6 +423,13 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
     cov = r.covariance
     model = Model._from_core(r.model)
+    unstable = unstable_warning_text(model)
+    if unstable is not None:
+        # said once here; the verdict's own simulation of the estimate stays silent
+        unstable = ("the identified " + unstable[len("the "):].split(": the periodic")[0]
+                    + ": its predicted steady state is the periodic solution of its equation, which "
+                    "a simulation from rest does not reach (fine for data from a stabilised experiment)")
+        warnings.warn(unstable, UnstableModelWarning, stacklevel=2)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -425,4 +440,5 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         normalized_residue=np.asarray(r.normalized_residue), fraction_above_0db=r.fraction_above_0db,
         fraction_expected=r.fraction_expected, fraction_band=tuple(r.fraction_band), noise_free=r.noise_free,
         warnings=tuple(r.warnings), data=data, eta_names=tuple(r.eta_names),
-        covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable)
+        covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
+        unstable=unstable)

@@ -227,7 +227,7 @@ def run(args) -> int:
             res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
                            max_iter=args.max_iter)
-            Y_pred = simulate(res.model, res.data.U)
+            Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
