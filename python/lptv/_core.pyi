@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -403,3 +403,5 @@ def time_signal(X: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[
     ...
 def weighted_r_factor(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+FDS_MAX_CONDITION: float = 10000000000000.0
+FDS_WARN_CONDITION: float = 100000000.0

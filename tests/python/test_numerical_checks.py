@@ -152,3 +152,78 @@ def test_identify_reports_an_unstable_identified_model_once():
     unstable = [w for w in rec if issubclass(w.category, lptv.UnstableModelWarning)]
     assert len(unstable) == 1 and "identified model is unstable" in str(unstable[0].message)
     assert "identified model is unstable" in res.unstable and res.unstable in res.summary()
+
+
+# ------------------------------------------------------------------ FDS conditioning
+EPS = np.finfo(float).eps
+
+
+def _oscillator(damping, wn=1.0):
+    return [wn ** 2, damping, 1.0]          # s^2 + damping s + wn^2
+
+
+@pytest.mark.parametrize("damping", [1e-9, 1e-12])
+def test_fds_warns_next_to_an_undamped_resonance_on_an_excited_line(damping):
+    den = _oscillator(damping)
+    m = lptv.Model(den, [1.0], w0=1.0)
+    with pytest.warns(lptv.ConditioningWarning, match="nearly singular on line 1") as rec:
+        r = lptv.simulate(m, _line1(), full_output=True)
+    assert "undamped resonance" in str(rec[0].message)
+    # the condition is that of the line, (wn^2 + damping + 1) / damping, exactly for LTI
+    cond = (2.0 + damping) / damping
+    assert r.condition == pytest.approx(cond, rel=1e-12) and r.condition_line == 1
+    # the value is still the model's exact steady state, to the digits the condition leaves
+    ref = 0.5 * _exact_line([1.0], den, 1.0)
+    assert abs(r.Y[1] - ref) <= 10 * cond * EPS * abs(ref)
+
+
+def test_fds_still_refuses_a_pole_on_the_line_within_rounding():
+    with pytest.raises(lptv.NumericalError, match="numerically singular near line -?1"):
+        lptv.simulate(lptv.Model(_oscillator(1e-15), [1.0], w0=1.0), _line1())
+
+
+@pytest.mark.parametrize("damping", [1e-2, 1e-6])
+def test_fds_silent_for_a_resolved_resonance(damping):
+    den = _oscillator(damping)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = lptv.simulate(lptv.Model(den, [1.0], w0=1.0), _line1(), full_output=True)
+    assert r.condition < lptv.fds.CONDITION_WARN
+    ref = 0.5 * _exact_line([1.0], den, 1.0)
+    assert abs(r.Y[1] - ref) <= 10 * r.condition * EPS * abs(ref)
+
+
+def test_fds_lti_resonance_on_a_line_without_input_is_silent():
+    # resonance on line 2 (wn = 2), input on lines 1 and 3: LTI lines do not couple
+    m = lptv.Model(_oscillator(1e-12, wn=2.0), [1.0], w0=1.0)
+    U = np.zeros(4, complex)
+    U[[1, 3]] = 0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lptv.simulate(m, U)
+    U[2] = 0.5
+    with pytest.warns(lptv.ConditioningWarning, match="line 2"):
+        lptv.simulate(m, U)
+
+
+def test_fds_lptv_warns_when_the_resonance_line_carries_output():
+    # a(s) constant, b(t) = 1 + 0.4 cos t: input on line 2 reaches lines 1..3, line 5 does not
+    # reach line 1 (A is diagonal, so its output there is exactly zero)
+    m = lptv.Model(_oscillator(1e-12), [[0.2, 1.0, 0.2]], w0=1.0)
+    U = np.zeros(8, complex)
+    U[2] = 0.5
+    with pytest.warns(lptv.ConditioningWarning, match="line 1"):
+        lptv.simulate(m, U)
+    U[2], U[5] = 0.0, 0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lptv.simulate(m, U)
+
+
+def test_fds_warns_for_a_discrete_pole_next_to_the_unit_circle_on_a_line():
+    # poles r exp(+-j 2 pi / 8) with r = 1 - 1e-12: on line 1 of N = 8
+    N, r = 8, 1.0 - 1e-12
+    th = 2 * np.pi / N
+    m = lptv.Model([r * r, -2 * r * np.cos(th), 1.0], [1.0], w0=2 * np.pi / N, ts=1.0)
+    with pytest.warns(lptv.ConditioningWarning, match="line 1"):
+        lptv.simulate(m, _line1())
