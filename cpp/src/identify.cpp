@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "lptv/diagnostics.hpp"
 #include "lptv/errors.hpp"
 #include "lptv/estimators.hpp"
 #include "lptv/likelihood.hpp"
@@ -76,6 +77,10 @@ Identification identify(const FrequencyData& d, const Structure& s, const Identi
   const Parametrisation p(s);
   const std::vector<int> rows = opt.rows.empty() ? default_rows(p, d.max_line()) : opt.rows;
   check_rows(p, rows, d.max_line());
+  // Degenerate data (no input power, a constant output, too few rows with signal, known
+  // coefficients that cannot fix the scale) are refused here with their cause, before they
+  // surface as a rank-deficient decomposition.
+  const DataDiagnosis diagnosis = diagnose_data(d, s, rows);
 
   EstimateOptions eo;
   eo.method = opt.method;
@@ -117,8 +122,24 @@ Identification identify(const FrequencyData& d, const Structure& s, const Identi
   res.residue_ok = res.fraction_above_0db >= res.fraction_expected.lo &&
                    res.fraction_above_0db <= res.fraction_expected.hi;
 
+  res.warnings = diagnosis.warnings;
   const bool weighted = opt.method == Method::GTLS || opt.method == Method::WGTLS || opt.method == Method::SML;
-  const auto& sv = er.singular_values;
+  // LS and TLS do not weigh the noise, so their own singular values say nothing about what the
+  // noise leaves determined: the test below reads those of the GTLS problem on the same rows
+  // (one more solve), so that an estimate the data do not determine is flagged whatever the
+  // method.
+  Eigen::VectorXd sv_noise;
+  if (!weighted && !er.noise_free) {
+    EstimateOptions go;
+    go.method = Method::GTLS;
+    try {
+      const EstimateResult g = estimate(d, p, rows, go);
+      if (!g.noise_free) sv_noise = g.singular_values;
+    } catch (const NumericalError&) {
+      // a rank-deficient GTLS pair: nothing to compare; the estimate stands as computed
+    }
+  }
+  const auto& sv = weighted ? er.singular_values : sv_noise;
   // Close smallest generalised singular values mean a second direction explains the data
   // almost as well. That points to too many harmonics or orders only when the residues are not
   // too large: an under-modelled fit has close values too, for a different reason, and puts
@@ -134,13 +155,16 @@ Identification identify(const FrequencyData& d, const Structure& s, const Identi
   const double m_dof = std::max(1.0, 2.0 * static_cast<double>(R) - res.n_free);
   const double c = std::min(0.5, std::sqrt(4.0 / m_dof));
   const double close = std::pow((1 + c) / (1 - c), 2);
-  if (weighted && !er.noise_free && sv.size() >= 2 && sv[1] * sv[1] < close * sv[0] * sv[0]) {
-    if (res.fraction_above_0db <= res.fraction_expected.hi) {
+  if (!er.noise_free && sv.size() >= 2 && sv[1] * sv[1] < close * sv[0] * sv[0]) {
+    // (LS, TLS: their residues are not those of the tested GTLS problem, so the gate does not
+    // apply to them.)
+    if (!weighted || res.fraction_above_0db <= res.fraction_expected.hi) {
       res.nearly_unidentifiable = true;
       res.warnings.push_back(format(
           "the two smallest generalised singular values are close (%.3g, %.3g): the model is nearly "
-          "unidentifiable; too many harmonics (a common periodic factor of numerator and denominator) "
-          "or too high orders are the likely cause", sv[0], sv[1]));
+          "unidentifiable; too many harmonics (a common periodic factor of numerator and denominator), "
+          "too high orders or too little signal above the noise are the likely causes", sv[0], sv[1]) +
+          (weighted ? "" : " (values of the noise-weighted GTLS problem on the same lines)"));
     }
   }
   if ((opt.method == Method::WGTLS || opt.method == Method::SML) && !er.converged) {

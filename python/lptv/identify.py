@@ -67,7 +67,8 @@ class IdentificationResult:
     corrected for noise variances estimated from the periods (see :func:`covariance_correction`);
     None for LS, TLS and GTLS."""
     nearly_unidentifiable: bool = False
-    """The two smallest generalised singular values are close while the residue test passes."""
+    """The two smallest generalised singular values are close while the residue test passes (LS,
+    TLS: those of the GTLS problem on the same lines, whatever the residues); see :attr:`undetermined`."""
     unstable: Optional[str] = None
     """A sentence when the identified model is unstable (a Floquet multiplier outside the unit
     circle; also warned as :class:`lptv.UnstableModelWarning`), None otherwise. Steady-state data
@@ -220,12 +221,35 @@ class IdentificationResult:
         return not self.model_errors
 
     @property
+    def undetermined(self) -> Optional[str]:
+        """Why the data do not determine the estimate (None when they do).
+
+        A residue test has no power when the noise explains anything: at a signal-to-noise ratio
+        near 0 dB every model passes it. What exposes such a fit is the identifiability test of
+        the core (:attr:`nearly_unidentifiable`: the two smallest generalised singular values of
+        the noise-weighted problem are within the Marchenko-Pastur band of a noise-only
+        subspace, i.e. a second parameter direction explains the data as well as the estimate;
+        for LS and TLS the GTLS problem on the same lines is tested). The verdict then does not
+        call the model consistent."""
+        if self.nearly_unidentifiable:
+            sv = self.singular_values
+            vals = f" ({sv[0]:.3g}, {sv[1]:.3g})" if sv.size >= 2 and self.method != "ls" else ""
+            return ("the data do not determine the model: a second parameter direction explains them "
+                    f"as well as the estimate (the two smallest generalised singular values are close{vals}); "
+                    "too little signal above the noise, too many harmonics or too high orders")
+        return None
+
+    @property
     def verdict(self) -> str:
-        """One sentence: is the model consistent with the noise, and if not, why."""
-        if self.model_ok:
+        """One sentence: is the model consistent with the noise, and if not, why. A fit the data
+        do not determine (:attr:`undetermined`) is never called consistent."""
+        if self.model_ok and self.undetermined is None:
             return ("the model is consistent with the noise: the fit shows no sign of modelling errors "
                     f"(on the {self.verdict_lines.size} excited lines)")
-        return "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+        if self.model_ok:
+            return "NOT DETERMINED: no sign of modelling errors, but " + self.undetermined
+        out = "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+        return out + ("; and " + self.undetermined if self.undetermined else "")
 
     def parameters(self, level: float = 0.95):
         """The parameter table: see :func:`lptv.parameter_table`."""
@@ -383,6 +407,28 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     tol, max_iter :
         WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
         ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
+
+    Raises
+    ------
+    ValueError
+        Besides bad arguments, degenerate data, diagnosed before estimating (METHOD.md section
+        14), with the argument and the cause: no input power on the fitted lines ("u: ... zero",
+        "u: ... at the level of its noise", or "u: the input is not excited on the fitted lines
+        ... it is excited on lines ..."), an output without variation there ("y: ..."), fewer
+        rows carrying signal than the parameters need ("lines: ..."), known coefficients that
+        cannot fix the scale or that zero a_na ("known: ...").
+    lptv.NumericalError
+        A decomposition failed on data that passed the diagnostics (the message says which).
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        The data do not determine the model (also :attr:`IdentificationResult.undetermined`; the
+        verdict then never says "consistent").
+    lptv.UnstableModelWarning
+        The identified model is unstable (also :attr:`IdentificationResult.unstable`).
+    UserWarning
+        The core's other warnings (:attr:`IdentificationResult.warnings`).
 
     Examples
     --------

@@ -280,6 +280,7 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "prediction_error_vs_noise_db": _prediction_gap_db(res, Y_pred),
         "fs": meas.fs, "trimmed_samples": meas.trimmed, "skipped_periods": meas.skipped,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
+        "undetermined": res.undetermined,
         "n_verdict_lines": int(res.verdict_lines.size), "verdict_fraction_above_0db": res.verdict_fraction,
         "verdict_band": list(res.verdict_band),
         "parameters": parameter_table(res),
