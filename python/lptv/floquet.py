@@ -168,7 +168,7 @@ def unstable_warning_text(model: Model) -> Optional[str]:
     """A sentence when ``model`` is unstable beyond its multipliers' error, None otherwise.
 
     For :func:`lptv.simulate`: LTI models from the roots of a(s) (a(z)); LPTV models from the
-    monodromy matrix by products (:func:`monodromy` with 64 and 128 steps, under a millisecond
+    monodromy matrix by products (:func:`monodromy` with 32 and 64 steps, under a millisecond
     where Hill's method takes ~0.1 s on the paper's model), their spectral radii differing by
     less than a tenth of the distance to 1, and from :func:`floquet` when they do not. The answer is kept on the model (its coefficients cannot change), so
     repeated simulations of one model pay for it once. A model floquet cannot treat (a_na(t)
@@ -205,7 +205,7 @@ def unstable_warning_text(model: Model) -> Optional[str]:
 
 def _lptv_unstable_text(model: Model) -> Optional[str]:
     rho = []
-    for steps in (64, 128):
+    for steps in (32, 64):
         Phi = monodromy(model, steps)
         rho.append(float(np.abs(np.linalg.eigvals(Phi)).max()) if np.all(np.isfinite(Phi)) else np.nan)
     if np.all(np.isfinite(rho)) and abs(rho[1] - rho[0]) < 0.1 * abs(rho[1] - 1.0):
