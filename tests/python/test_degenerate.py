@@ -147,3 +147,15 @@ def test_verdict_consistent_on_good_data(seed):
            / np.linalg.norm(np.r_[true.a.ravel(), true.b.ravel()]))
     assert err < 0.05
     assert res.undetermined is None and "consistent with the noise" in res.verdict
+
+
+def test_rows_without_input_warn_with_the_excited_lines():
+    # a(t) with two harmonics spreads the output of lines 10 and 20 to the rows 12..18 between
+    # them, which hold no input line (Kb = 0): the fit sees output only, and b is fitted to noise
+    # (1.5 here for a true 1)
+    m = lptv.Model([[0.1, 0.2, 1.0, 0.2, 0.1], [0, 0, 1.0, 0, 0]], [[1.0]], w0=W0)
+    u, y = _periods([10, 20], 4, 0, noise=1e-6, model=m)
+    with pytest.warns(UserWarning, match=r"none of the fitted lines has an input line 20 dB above its "
+                                         r"noise within \+-0 \(the input is excited on lines 10, 20"):
+        res = lptv.identify(u, y, na=1, nb=0, ka=[2, 2], kb=0, w0=W0, lines=range(12, 19), method="ls")
+    assert "consistent with the noise" not in res.verdict
