@@ -132,8 +132,9 @@ class IdentificationResult:
 
     # -- the verdict --------------------------------------------------------------
     @cached_property
-    def _verdict_mask(self) -> np.ndarray:
-        """Which rows the verdict judges (see :attr:`verdict_lines`), per experiment."""
+    def verdict_mask(self) -> np.ndarray:
+        """Per row of ``lines``: does the verdict judge it (see :attr:`verdict_lines`)? With
+        several experiments each experiment's own excited lines."""
         K = max(self.model.ka, self.model.kb)
         if self.experiments:
             mask = np.zeros(self.lines.size, bool)
@@ -158,7 +159,7 @@ class IdentificationResult:
         """The rows the verdict judges: the fit rows at the excited lines (and within +-K of them
         for an LPTV model); all fit rows when no line stands above the input noise. With several
         experiments, each experiment's own excited lines, in the order of ``lines``."""
-        return self.lines[self._verdict_mask]
+        return self.lines[self.verdict_mask]
 
     def _periods(self) -> np.ndarray:
         """P per row of ``lines`` (0: statistics from elsewhere)."""
@@ -168,7 +169,7 @@ class IdentificationResult:
 
     @cached_property
     def _verdict_stats(self):
-        mask = self._verdict_mask
+        mask = self.verdict_mask
         r = self.normalized_residue[mask]
         n = int(mask.sum())
         frac = float(np.mean(r > 1.0)) if n else float("nan")
@@ -224,7 +225,7 @@ class IdentificationResult:
         experiment = self.experiment if self.experiments else np.zeros(self.lines.size, int)
         err, noise = [], []
         for e, d in enumerate(datas):
-            rows = self.lines[self._verdict_mask & (experiment == e)]
+            rows = self.lines[self.verdict_mask & (experiment == e)]
             if rows.size == 0:
                 continue
             try:
