@@ -7,6 +7,7 @@ import functools
 import json
 import subprocess
 import sys
+import warnings
 from types import SimpleNamespace
 
 import numpy as np
@@ -122,7 +123,8 @@ def test_estimators_match_reference(seed, domain, lti, method, id_tol):
     s, recs, excited = three_experiments(seed, domain, lti)
     datas = [ref.frequency_data(u, y) for u, y in recs]
     rows = _reference_rows(s, datas, excited)
-    with _no_fail():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # e.g. close singular values of unweighted GTLS
         res = _fit(s, recs, method, [None, rows[1], "excited"])
     assert res.n_experiments == 3
     assert np.array_equal(res.lines, np.concatenate(rows))
@@ -140,6 +142,12 @@ def test_estimators_match_reference(seed, domain, lti, method, id_tol):
     scale = np.concatenate([np.abs(ref.jacobian(d, s.par, r)) @ np.abs(rr["theta"]) for d, r in zip(datas, rows)])
     assert np.all(np.abs(res.residue - e) <= id_tol.ESTIMATE * scale)
     assert np.all(np.abs(res.residue_variance - v) <= id_tol.ESTIMATE * v)
+    # P = 5, 8, 6: each row's expected fraction above 0 dB for its own P, averaged over the rows.
+    n_rows = sum(r.size for r in rows)
+    p = [ref.expected_fraction_above_0db(n_rows, s.par.n_xi - 1, d.periods) for d in datas]
+    expected = sum(pe * r.size for pe, r in zip(p, rows)) / n_rows
+    assert res.fraction_expected == pytest.approx(expected, rel=id_tol.FRACTION, abs=0)
+    assert res.fraction_above_0db == np.mean(np.abs(e) / np.sqrt(v) > 1.0)
     if method == "wgtls":
         assert res.converged and rr["converged"] and res.iterations == rr["iterations"]
         assert rel(res.theta, s.theta) < 0.1  # consistent: near the truth at this SNR
@@ -155,19 +163,6 @@ def test_estimators_match_reference(seed, domain, lti, method, id_tol):
         assert rel(res.covariance, cov) <= COVARIANCE
 
 
-class _no_fail:
-    """Warnings (e.g. close singular values of unweighted GTLS) do not matter here."""
-
-    def __enter__(self):
-        import warnings
-        self._c = warnings.catch_warnings()
-        self._c.__enter__()
-        warnings.simplefilter("ignore")
-
-    def __exit__(self, *a):
-        return self._c.__exit__(*a)
-
-
 @pytest.mark.parametrize("seed,domain,lti", [(s, d, l) for s in SEEDS[:2] for d in ("ct", "dt")
                                              for l in (False, True)],
                          ids=lambda v: str(v) if not isinstance(v, bool) else ("lti" if v else "lptv"))
@@ -175,7 +170,8 @@ def test_sml_matches_reference(seed, domain, lti):
     s, recs, excited = three_experiments(seed, domain, lti)
     datas = [ref.frequency_data(u, y) for u, y in recs]
     rows = _reference_rows(s, datas, excited)
-    with _no_fail():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # e.g. close singular values of unweighted GTLS
         res = _fit(s, recs, "sml", [None, rows[1], "excited"])
     start = ref.estimate_experiments(datas, s.par, rows, "wgtls", tol=TOL, max_iter=MAX_ITER)["theta"]
     fit = lk.sml_estimate_experiments(datas, s.par, rows, start)
