@@ -293,6 +293,9 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
 
         fig = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
+    if res.data is None:
+        raise ValueError("res: bode needs the fit of one data set (res.data); a fit of several experiments "
+                         "has none: draw each experiment's FrequencyData (res.experiments) separately")
     d, model = res.data, res.model
     rows = np.asarray(res.verdict_lines)
     U, Y = d.U[rows], d.Y[rows]
