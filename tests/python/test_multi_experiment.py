@@ -249,6 +249,27 @@ def test_experiments_identify_together_what_neither_does_alone(seed, method):
     assert res.model_ok
 
 
+def test_bode_of_several_experiments_draws_each_record_on_its_excited_lines():
+    """The joint fit's Bode plot: one set of measured points per record, at that record's excited
+    lines (its own Y / U), and the joint model's curve."""
+    pytest.importorskip("matplotlib")
+    from lptv import plots
+
+    s = system(1, "ct", True)
+    rng = np.random.default_rng(7)
+    a, b = periods(s, 63, 6, np.arange(1, 12), rng), periods(s, 95, 8, np.arange(10, 40), rng)
+    res = lptv.identify([a, b], na=2, nb=1, w0=s.w0, method="wgtls")
+    ax_m = plots.bode(res).axes[0]
+    pts = {c.get_label(): c for c in ax_m.containers}
+    assert sorted(pts) == ["experiment 0 Y/U (+-2 std)", "experiment 1 Y/U (+-2 std)"]
+    for e, (u, y) in enumerate((a, b)):
+        d = lptv.FrequencyData.from_periods(u, y, w0=s.w0)
+        rows = res.lines[res.verdict_mask & (res.experiment == e)]
+        x, ydb = pts[f"experiment {e} Y/U (+-2 std)"].lines[0].get_data()
+        assert np.allclose(x, rows * s.w0)
+        assert np.allclose(ydb, 20 * np.log10(np.abs(d.Y[rows] / d.U[rows])))
+
+
 # ------------------------------------------------------------------ Cramer-Rao bound, several
 
 @pytest.mark.parametrize("domain", ["ct", "dt"])

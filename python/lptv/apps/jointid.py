@@ -152,6 +152,10 @@ def _report(records, res, summary) -> Report:
                 f"{x['n_lines']} ({x['first_line']} to {x['last_line']})",
                 f"{100 * x['fraction_above_0db']:.1f} %"] for e, x in enumerate(summary["experiments"])])
     rep.preformatted(res.summary())
+    fig = plots.bode(res)
+    rep.figure(fig, "bode.png",
+               "Bode plot: each record's measured FRF Y/U on its excited lines (+-2 std from its periods), "
+               "the joint model's time-averaged response and its 95 % band from the parameter covariance.")
     for e, (src, meas, d) in enumerate(records):
         idx, rows = _experiment_rows(res, e)
         excited = rows[res.verdict_mask[idx]]
