@@ -98,7 +98,8 @@ ChannelPower channel_power(const Eigen::VectorXcd& X, const Eigen::VectorXd& var
   return c;
 }
 
-DataDiagnosis diagnose_data(const FrequencyData& d, const Structure& s, const std::vector<int>& rows) {
+DataDiagnosis diagnose_data(const FrequencyData& d, const Structure& s, const std::vector<int>& rows,
+                            bool check_row_count) {
   check_known(s);
   DataDiagnosis out;
   const int L = d.max_line(), K = s.kmax();
@@ -170,7 +171,7 @@ DataDiagnosis diagnose_data(const FrequencyData& d, const Structure& s, const st
     out.informative_rows += u || any_above(d.Y, d.varY, yfloor, r, Ka);
   }
   const long long n_free = s.n_unknowns();
-  if (out.input.clear && 2LL * out.informative_rows <= n_free) {
+  if (check_row_count && out.input.clear && 2LL * out.informative_rows <= n_free) {
     throw std::invalid_argument(
         "lines: only " + std::to_string(out.informative_rows) + " of the " + std::to_string(rows.size()) +
         " fitted lines carry signal (an input line 20 dB above its noise within +-" + std::to_string(Kb) +

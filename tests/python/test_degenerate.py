@@ -159,3 +159,14 @@ def test_rows_without_input_warn_with_the_excited_lines():
                                          r"noise within \+-0 \(the input is excited on lines 10, 20"):
         res = lptv.identify(u, y, na=1, nb=0, ka=[2, 2], kb=0, w0=W0, lines=range(12, 19), method="ls")
     assert "consistent with the noise" not in res.verdict
+
+
+def test_identifiability_warning_is_whole():
+    # the core's message is built past a fixed-size buffer: it must end as written
+    m = lptv.Model([[0.1, 0.2, 1.0, 0.2, 0.1], [0, 0, 1.0, 0, 0]], [[1.0]], w0=W0)
+    u, y = _periods([10, 20], 4, 0, noise=1e-6, model=m)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = lptv.identify(u, y, na=1, nb=0, ka=[2, 2], kb=0, w0=W0, lines=range(12, 19), method="ls")
+    msg = [w for w in res.warnings if "unidentifiable" in w]
+    assert msg and msg[0].endswith("the likely causes (values of the noise-weighted GTLS problem on the same lines)")

@@ -1,7 +1,7 @@
 // What the data can say before anything is estimated: is the input excited on the fitted lines,
 // does the output respond, do enough rows carry signal for the parameters, can the known
 // coefficients fix the scale. lptv::identify runs it first, so degenerate data give a message
-// naming the cause (METHOD.md section 14) instead of a failed decomposition further down.
+// naming the cause (METHOD.md section 15) instead of a failed decomposition further down.
 #pragma once
 #include <string>
 #include <vector>
@@ -60,7 +60,10 @@ struct DataDiagnosis {
 // than the free parameters need ("lines: ..."), known coefficients that cannot fix the scale
 // (all zero) or that zero the highest-order coefficient ("known: ..."). rows: the fit's rows,
 // already checked against the data.
-DataDiagnosis diagnose_data(const FrequencyData& d, const Structure& s, const std::vector<int>& rows);
+// check_row_count false: no "lines: ..." refusal (for one of several experiments, whose rows
+// are counted together by lptv::identify).
+DataDiagnosis diagnose_data(const FrequencyData& d, const Structure& s, const std::vector<int>& rows,
+                            bool check_row_count = true);
 
 // "10, 20, 30, ..., 240 (24 lines)": a list of lines for a message.
 std::string format_lines(const std::vector<int>& lines, int head = 4);
