@@ -170,3 +170,21 @@ def test_identifiability_warning_is_whole():
         res = lptv.identify(u, y, na=1, nb=0, ka=[2, 2], kb=0, w0=W0, lines=range(12, 19), method="ls")
     msg = [w for w in res.warnings if "unidentifiable" in w]
     assert msg and msg[0].endswith("the likely causes (values of the noise-weighted GTLS problem on the same lines)")
+
+
+def test_several_experiments_name_the_dead_one():
+    good = _periods(range(1, 60), 4, 0)
+    u, y = _periods(range(1, 60), 4, 1)
+    with pytest.raises(ValueError, match=r"^experiment 1: u: the input spectrum is zero on the fitted lines"):
+        lptv.identify([good, (np.zeros_like(u), y)], **FIT)
+    # records that each carry too few rows with signal (4 real equations, 4 parameters) complete
+    # each other; one line each is still too few together
+    a, b = _periods([10, 11], 4, 2), _periods([30, 31], 4, 3)
+    for e in (a, b):
+        with pytest.raises(ValueError, match=r"^lines: only 2 of the 11 fitted lines carry signal"):
+            lptv.identify(*e, lines=range(5, 16) if e is a else range(25, 36), method="ls", **FIT)
+    res = lptv.identify([a, b], lines=[range(5, 16), range(25, 36)], method="ls", **FIT)
+    np.testing.assert_allclose(res.model.a[:, 0].real, TRUE.a[:, 0].real, rtol=1e-2)
+    a1, b1 = _periods([10], 4, 2), _periods([30], 4, 3)
+    with pytest.raises(ValueError, match=r"^lines: only 2 of the fitted lines of all experiments carry signal"):
+        lptv.identify([a1, b1], lines=[range(5, 16), range(25, 36)], method="ls", **FIT)
