@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "lptv/diagnostics.hpp"
 #include "lptv/errors.hpp"
 #include "lptv/estimators.hpp"
 #include "lptv/likelihood.hpp"
@@ -156,7 +157,29 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
                    res.fraction_above_0db <= res.fraction_expected.hi;
 
   const bool weighted = opt.method == Method::GTLS || opt.method == Method::WGTLS || opt.method == Method::SML;
-  const auto& sv = er.singular_values;
+  // LS and TLS do not weigh the noise, so their own singular values say nothing about what the
+  // noise leaves determined: the test below reads those of the GTLS problem on the same rows
+  // (one more solve), so that an estimate the data do not determine is flagged whatever the
+  // method.
+  Eigen::VectorXd sv_noise;
+  if (!weighted && !er.noise_free) {
+    EstimateOptions go;
+    go.method = Method::GTLS;
+    try {
+      EstimateResult g;
+      if (E == 1) {
+        g = estimate(*ds[0], p, rows[0], go);
+      } else {
+        std::vector<FrequencyData> copies;
+        for (const FrequencyData* d : ds) copies.push_back(*d);
+        g = estimate(copies, p, rows, go);
+      }
+      if (!g.noise_free) sv_noise = g.singular_values;
+    } catch (const NumericalError&) {
+      // a rank-deficient GTLS pair: nothing to compare; the estimate stands as computed
+    }
+  }
+  const auto& sv = weighted ? er.singular_values : sv_noise;
   // Close smallest generalised singular values mean a second direction explains the data
   // almost as well. That points to too many harmonics or orders only when the residues are not
   // too large: an under-modelled fit has close values too, for a different reason, and puts
@@ -172,13 +195,17 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
   const double m_dof = std::max(1.0, 2.0 * static_cast<double>(R) - res.n_free);
   const double c = std::min(0.5, std::sqrt(4.0 / m_dof));
   const double close = std::pow((1 + c) / (1 - c), 2);
-  if (weighted && !er.noise_free && sv.size() >= 2 && sv[1] * sv[1] < close * sv[0] * sv[0]) {
-    if (res.fraction_above_0db <= res.fraction_expected.hi) {
+  if (!er.noise_free && sv.size() >= 2 && sv[1] * sv[1] < close * sv[0] * sv[0]) {
+    // (LS, TLS: their residues are not those of the tested GTLS problem, so the gate does not
+    // apply to them.)
+    if (!weighted || res.fraction_above_0db <= res.fraction_expected.hi) {
       res.nearly_unidentifiable = true;
-      res.warnings.push_back(format(
-          "the two smallest generalised singular values are close (%.3g, %.3g): the model is nearly "
-          "unidentifiable; too many harmonics (a common periodic factor of numerator and denominator) "
-          "or too high orders are the likely cause", sv[0], sv[1]));
+      // (format() holds 256 characters: the numbers only)
+      res.warnings.push_back(
+          format("the two smallest generalised singular values are close (%.3g, %.3g): ", sv[0], sv[1]) +
+          "the model is nearly unidentifiable; too many harmonics (a common periodic factor of numerator "
+          "and denominator), too high orders or too little signal above the noise are the likely causes" +
+          (weighted ? "" : " (values of the noise-weighted GTLS problem on the same lines)"));
     }
   }
   if ((opt.method == Method::WGTLS || opt.method == Method::SML) && !er.converged) {
@@ -315,7 +342,13 @@ Identification identify(const FrequencyData& d, const Structure& s, const Identi
   const Parametrisation p(s);
   std::vector<std::vector<int>> rows{opt.rows.empty() ? default_rows(p, d.max_line()) : opt.rows};
   check_rows(p, rows[0], d.max_line());
-  return identify_experiments({&d}, rows, p, opt);
+  // Degenerate data (no input power, a constant output, too few rows with signal, known
+  // coefficients that cannot fix the scale) are refused here with their cause, before they
+  // surface as a rank-deficient decomposition.
+  const DataDiagnosis diagnosis = diagnose_data(d, s, rows[0]);
+  Identification res = identify_experiments({&d}, rows, p, opt);
+  res.warnings.insert(res.warnings.begin(), diagnosis.warnings.begin(), diagnosis.warnings.end());
+  return res;
 }
 
 Identification identify(const std::vector<FrequencyData>& experiments, const Structure& s,
@@ -369,7 +402,32 @@ Identification identify(const std::vector<FrequencyData>& experiments, const Str
     rows[e] = given ? opt.experiment_rows[e] : default_rows(p, experiments[e].max_line());
     ds.push_back(&experiments[e]);
   }
-  return identify_experiments(ds, rows, p, opt);
+  // The diagnostics per experiment (a dead channel in one record is named with it); the rows
+  // carrying signal are counted over all of them, since records complete each other.
+  std::vector<std::string> warnings;
+  long long informative = 0;
+  bool clear = false;
+  for (size_t e = 0; e < E; ++e) {
+    DataDiagnosis dd;
+    try {
+      dd = diagnose_data(experiments[e], s, rows[e], false);
+    } catch (const std::invalid_argument& err) {
+      throw std::invalid_argument("experiment " + std::to_string(e) + ": " + err.what());
+    }
+    informative += dd.informative_rows;
+    clear = clear || dd.input.clear;
+    for (const auto& w : dd.warnings) warnings.push_back("experiment " + std::to_string(e) + ": " + w);
+  }
+  if (clear && 2 * informative <= s.n_unknowns()) {
+    throw std::invalid_argument(
+        "lines: only " + std::to_string(informative) + " of the fitted lines of all experiments carry "
+        "signal: " + std::to_string(2 * informative) + " real equations for " +
+        std::to_string(s.n_unknowns()) + " free parameters; fit lines next to the excited ones, "
+        "excite more lines, or use fewer harmonics / lower orders");
+  }
+  Identification res = identify_experiments(ds, rows, p, opt);
+  res.warnings.insert(res.warnings.begin(), warnings.begin(), warnings.end());
+  return res;
 }
 
 }  // namespace lptv

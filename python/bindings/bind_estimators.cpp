@@ -1,3 +1,4 @@
+#include "lptv/diagnostics.hpp"
 #include "lptv/estimators.hpp"
 #include "pybind11.hpp"
 
@@ -92,4 +93,23 @@ void bind_estimators(py::module_& m) {
 
 rows: one list of rows per experiment (an empty list: that experiment's default rows), or
 empty for every experiment's default.)doc");
+
+  py::class_<lptv::ChannelPower>(m, "ChannelPower", "Signal of one channel on a set of lines (lptv::channel_power).")
+      .def_readonly("lines", &lptv::ChannelPower::lines)
+      .def_readonly("above", &lptv::ChannelPower::above)
+      .def_readonly("power", &lptv::ChannelPower::power)
+      .def_readonly("noise", &lptv::ChannelPower::noise)
+      .def_readonly("limit", &lptv::ChannelPower::limit)
+      .def_readonly("clear", &lptv::ChannelPower::clear)
+      .def_readonly("present", &lptv::ChannelPower::present);
+  py::class_<lptv::DataDiagnosis>(m, "DataDiagnosis", "What the data can say before estimating (lptv::diagnose_data).")
+      .def_readonly("region", &lptv::DataDiagnosis::region)
+      .def_readonly("input", &lptv::DataDiagnosis::input)
+      .def_readonly("output", &lptv::DataDiagnosis::output)
+      .def_readonly("excited", &lptv::DataDiagnosis::excited)
+      .def_readonly("informative_rows", &lptv::DataDiagnosis::informative_rows)
+      .def_readonly("warnings", &lptv::DataDiagnosis::warnings);
+  m.def("diagnose_data", &lptv::diagnose_data, "data"_a, "structure"_a, "rows"_a, "check_row_count"_a = true,
+        "The data diagnostics lptv::identify runs first: raises ValueError naming the argument and the "
+        "cause for degenerate data (METHOD.md section 15).");
 }

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'DataDiagnosis', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -302,6 +302,53 @@ class Identification:
     @property
     def warnings(self) -> list[str]:
         ...
+class ChannelPower:
+    """
+    Signal of one channel on a set of lines (lptv::channel_power).
+    """
+    @property
+    def above(self) -> int:
+        ...
+    @property
+    def clear(self) -> bool:
+        ...
+    @property
+    def limit(self) -> float:
+        ...
+    @property
+    def lines(self) -> int:
+        ...
+    @property
+    def noise(self) -> float:
+        ...
+    @property
+    def power(self) -> float:
+        ...
+    @property
+    def present(self) -> bool:
+        ...
+class DataDiagnosis:
+    """
+    What the data can say before estimating (lptv::diagnose_data).
+    """
+    @property
+    def excited(self) -> list[int]:
+        ...
+    @property
+    def informative_rows(self) -> int:
+        ...
+    @property
+    def input(self) -> ChannelPower:
+        ...
+    @property
+    def output(self) -> ChannelPower:
+        ...
+    @property
+    def region(self) -> list[int]:
+        ...
+    @property
+    def warnings(self) -> list[str]:
+        ...
 class HtfEstimate:
     """
     Nonparametric HTF branches (lptv::htf_estimate).
@@ -368,6 +415,10 @@ def crest_factor(x: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m,
     ...
 def default_solver(discrete: bool = False) -> str:
     ...
+def diagnose_data(data: FrequencyData, structure: Structure, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], check_row_count: bool = True) -> DataDiagnosis:
+    """
+    The data diagnostics lptv::identify runs first: raises ValueError naming the argument and the cause for degenerate data (METHOD.md section 15).
+    """
 def estimate(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50) -> EstimateResult:
     ...
 def eta_covariance(par: Parametrisation, cov_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
@@ -420,3 +471,5 @@ def time_signal(X: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[
     ...
 def weighted_r_factor(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+FDS_MAX_CONDITION: float = 10000000000000.0
+FDS_WARN_CONDITION: float = 100000000.0

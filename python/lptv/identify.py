@@ -11,6 +11,7 @@ import numpy as np
 
 from . import _core
 from .data import FrequencyData, experiments_of, frequency_data_of
+from .floquet import UnstableModelWarning, unstable_warning_text
 from .model import Model
 from ._validate import as_positive_float
 
@@ -73,7 +74,13 @@ class IdentificationResult:
     corrected for noise variances estimated from the periods (see :func:`covariance_correction`);
     None for LS, TLS and GTLS."""
     nearly_unidentifiable: bool = False
-    """The two smallest generalised singular values are close while the residue test passes."""
+    """The two smallest generalised singular values are close while the residue test passes (LS,
+    TLS: those of the GTLS problem on the same lines, whatever the residues); see :attr:`undetermined`."""
+    unstable: Optional[str] = None
+    """A sentence when the identified model is unstable (a Floquet multiplier outside the unit
+    circle; also warned as :class:`lptv.UnstableModelWarning`), None otherwise. Steady-state data
+    of a stabilised experiment identify an unstable system correctly; the sentence says what its
+    predicted output means."""
     experiment: Optional[np.ndarray] = field(default=None, repr=False)
     """Per row of ``lines``: the index of the experiment it belongs to (all 0 for one data set)."""
     experiments: Tuple[FrequencyData, ...] = field(default_factory=tuple, repr=False)
@@ -231,7 +238,7 @@ class IdentificationResult:
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    Yp = np.asarray(simulate(self.model, d.U))
+                    Yp = np.asarray(simulate(self.model, d.U, warn_unstable=False))
             except Exception:
                 return None
             if Yp.shape != d.Y.shape:
@@ -273,12 +280,35 @@ class IdentificationResult:
         return not self.model_errors
 
     @property
+    def undetermined(self) -> Optional[str]:
+        """Why the data do not determine the estimate (None when they do).
+
+        A residue test has no power when the noise explains anything: at a signal-to-noise ratio
+        near 0 dB every model passes it. What exposes such a fit is the identifiability test of
+        the core (:attr:`nearly_unidentifiable`: the two smallest generalised singular values of
+        the noise-weighted problem are within the Marchenko-Pastur band of a noise-only
+        subspace, i.e. a second parameter direction explains the data as well as the estimate;
+        for LS and TLS the GTLS problem on the same lines is tested). The verdict then does not
+        call the model consistent."""
+        if self.nearly_unidentifiable:
+            sv = self.singular_values
+            vals = f" ({sv[0]:.3g}, {sv[1]:.3g})" if sv.size >= 2 and self.method != "ls" else ""
+            return ("the data do not determine the model: a second parameter direction explains them "
+                    f"as well as the estimate (the two smallest generalised singular values are close{vals}); "
+                    "too little signal above the noise, too many harmonics or too high orders")
+        return None
+
+    @property
     def verdict(self) -> str:
-        """One sentence: is the model consistent with the noise, and if not, why."""
-        if self.model_ok:
+        """One sentence: is the model consistent with the noise, and if not, why. A fit the data
+        do not determine (:attr:`undetermined`) is never called consistent."""
+        if self.model_ok and self.undetermined is None:
             return ("the model is consistent with the noise: the fit shows no sign of modelling errors "
                     f"(on the {self.verdict_lines.size} excited lines)")
-        return "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+        if self.model_ok:
+            return "NOT DETERMINED: no sign of modelling errors, but " + self.undetermined
+        out = "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+        return out + ("; and " + self.undetermined if self.undetermined else "")
 
     def parameters(self, level: float = 0.95):
         """The parameter table: see :func:`lptv.parameter_table`."""
@@ -308,6 +338,8 @@ class IdentificationResult:
         lines.append(format_parameter_table(self))
         lines.append(f"verdict: {self.verdict}")
         lines += [f"warning: {w}" for w in self.warnings]
+        if self.unstable:
+            lines.append(f"warning: {self.unstable}")
         return "\n".join(lines)
 
 
@@ -447,6 +479,28 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
         ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
 
+    Raises
+    ------
+    ValueError
+        Besides bad arguments, degenerate data, diagnosed before estimating (METHOD.md section
+        14), with the argument and the cause: no input power on the fitted lines ("u: ... zero",
+        "u: ... at the level of its noise", or "u: the input is not excited on the fitted lines
+        ... it is excited on lines ..."), an output without variation there ("y: ..."), fewer
+        rows carrying signal than the parameters need ("lines: ..."), known coefficients that
+        cannot fix the scale or that zero a_na ("known: ...").
+    lptv.NumericalError
+        A decomposition failed on data that passed the diagnostics (the message says which).
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        The data do not determine the model (also :attr:`IdentificationResult.undetermined`; the
+        verdict then never says "consistent").
+    lptv.UnstableModelWarning
+        The identified model is unstable (also :attr:`IdentificationResult.unstable`).
+    UserWarning
+        The core's other warnings (:attr:`IdentificationResult.warnings`).
+
     Examples
     --------
     >>> import numpy as np, lptv
@@ -497,6 +551,13 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
     cov = r.covariance
     model = Model._from_core(r.model)
+    unstable = unstable_warning_text(model)
+    if unstable is not None:
+        # said once here; the verdict's own simulation of the estimate stays silent
+        unstable = ("the identified " + unstable[len("the "):].split(": the periodic")[0]
+                    + ": its predicted steady state is the periodic solution of its equation, which "
+                    "a simulation from rest does not reach (fine for data from a stabilised experiment)")
+        warnings.warn(unstable, UnstableModelWarning, stacklevel=2)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -508,7 +569,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         fraction_expected=r.fraction_expected, fraction_band=tuple(r.fraction_band), noise_free=r.noise_free,
         warnings=tuple(r.warnings), data=None if several else data, eta_names=tuple(r.eta_names),
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
-        experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else ())
+        experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
+        unstable=unstable)
 
 
 def _experiment_rows(datas, lines, K):

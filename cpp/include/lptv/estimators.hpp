@@ -112,6 +112,7 @@ struct Identification {
   ExpectedFraction fraction_expected{0, 0, 0};
   bool residue_ok = false;            // fraction_above_0db inside the expected band
   bool nearly_unidentifiable = false; // the two smallest generalised singular values are close
+                                      // (LS, TLS: those of the GTLS problem on the same rows)
   bool noise_free = false;
   // WGTLS (sandwich) and SML (inverse Fisher information), times covariance_correction(P):
   // n_eta x n_eta, zero row and column for the normalised parameter; empty otherwise. With

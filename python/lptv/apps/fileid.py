@@ -237,7 +237,7 @@ def run(args) -> int:
             res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
                            max_iter=args.max_iter)
-            Y_pred = simulate(res.model, res.data.U)
+            Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
@@ -290,6 +290,7 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "prediction_error_vs_noise_db": _prediction_gap_db(res, Y_pred),
         "fs": meas.fs, "trimmed_samples": meas.trimmed, "skipped_periods": meas.skipped,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
+        "undetermined": res.undetermined,
         "n_verdict_lines": int(res.verdict_lines.size), "verdict_fraction_above_0db": res.verdict_fraction,
         "verdict_band": list(res.verdict_band),
         "parameters": parameter_table(res),
