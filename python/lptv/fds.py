@@ -8,7 +8,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_positive_float, as_spectrum, as_str
+from ._validate import as_bool, as_int, as_positive_float, as_spectrum, as_str
 
 SOLVERS = ("auto", "band", "klu", "umfpack")
 from .model import Model
@@ -91,6 +91,7 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     max_guard = -1 if max_guard is None else as_int(max_guard, "max_guard")
     tol = as_positive_float(tol, "tol")
     solver = as_str(solver, "solver", SOLVERS)
+    full_output = as_bool(full_output, "full_output")
     r = _core.simulate(model._cpp, Ua, solver=solver, lines_out=lines_out, guard=guard, tol=tol,
                        max_guard=max_guard)
     Y = np.asarray(r["Y"])
