@@ -11,7 +11,7 @@ from typing import Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .._validate import as_float, as_int, as_positive_float
+from .._validate import as_float, as_int, as_path, as_positive_float
 from ..identify import METHODS, _counts, _known_list, _rows, identify
 from ..measurements import Measurements, read_measurements
 from ..model import Model
@@ -113,7 +113,7 @@ class BatchResult:
 
     def save(self, path) -> Path:
         """Write the rows as CSV (plain Python) or Parquet (by the suffix; needs pyarrow)."""
-        path = Path(os.fspath(path))
+        path = Path(as_path(path))
         if path.suffix.lower() == ".parquet":
             require("pyarrow", "writing Parquet")
             self.table().to_parquet(path, index=False)
