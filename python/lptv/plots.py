@@ -97,6 +97,15 @@ def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zero
     reads off as an angle); by default it is on unless the curves are far wider than tall (the
     paper's Fig. 3), and always on in the z-plane.
     """
+    from ._validate import as_bool
+
+    t = _series(t, "t")
+    for name, arr in (("poles_true", poles_true), ("zeros_true", zeros_true), ("poles_est", poles_est),
+                      ("zeros_est", zeros_est)):
+        if arr is not None:
+            _series(np.atleast_2d(arr) if np.ndim(arr) < 2 else arr, name, t.size, ndim=2)
+    discrete = as_bool(discrete, "discrete")
+    zoom_on_poles = as_bool(zoom_on_poles, "zoom_on_poles")
     ax = _axes(ax)
     style = {"true": dict(lw=2.0, alpha=0.5), "est": dict(lw=1.0, ls="--")}
     drawn = []

@@ -653,6 +653,9 @@ def python_cases():
              match=names("Y")),
         Case("plots.coefficients-t-str", "type", lambda: _plots().coefficients("abc", est=np.ones((3, 2))),
              match=names("t")),
+        Case("plots.frozen_poles_zeros-t-str", "type", lambda: _plots().frozen_poles_zeros("abc"), match=names("t")),
+        Case("plots.frozen_poles_zeros-poles-rows", "shape",
+             lambda: _plots().frozen_poles_zeros([0.0, 1.0], poles_est=np.zeros((3, 2))), match=names("poles_est")),
         Case("plots.htf_branches-est-str", "type", lambda: _plots().htf_branches("abc"), match=names("est")),
         Case("plots.compare-cmp-str", "type", lambda: _plots().compare("abc"), match=names("cmp")),
         Case("plots.output_spectrum-w0-nan", "nan/inf", lambda: _plots().output_spectrum([1, 2], [1.0, 1.0], w0=NaN),
@@ -837,15 +840,21 @@ def _short(x):
     return s if len(s) < 120 else s[:117] + "..."
 
 
+def _limit_memory():
+    """A runaway allocation is a MemoryError in the case's process, not the machine's memory."""
+    import resource
+
+    gb = 4 * 2**30
+    resource.setrlimit(resource.RLIMIT_AS, (gb, gb))
+
+
 def _child(ids):
     """Run the named cases here, one JSON line each, flushed before the next starts."""
     import faulthandler
-    import resource
     import signal
 
     faulthandler.enable()
-    gb = 4 * 2**30   # a runaway allocation is a MemoryError here, not the machine's memory
-    resource.setrlimit(resource.RLIMIT_AS, (gb, gb))
+    _limit_memory()
 
     def timeout(signum, frame):
         raise TimeoutError("the case ran past its time limit")
@@ -905,7 +914,7 @@ def run_cli_case(case: Case, d: Path):
     argv = [a.replace("{dir}", str(d)) for a in case.argv]
     try:
         p = subprocess.run([sys.executable, "-m", "lptv", *argv], capture_output=True, text=True,
-                           env=_env(), cwd=d, timeout=60)
+                           env=_env(), cwd=d, timeout=60, preexec_fn=_limit_memory)
     except subprocess.TimeoutExpired:
         return _judge(case, "timeout", "")
     return _judge(case, p.returncode, p.stderr)
@@ -924,6 +933,7 @@ def _cli_server(d):
         err = tempfile.TemporaryFile()
         pid = os.fork()
         if pid == 0:
+            _limit_memory()
             os.dup2(err.fileno(), 2)
             devnull = os.open(os.devnull, os.O_WRONLY)
             os.dup2(devnull, 1)
