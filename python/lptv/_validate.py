@@ -251,7 +251,10 @@ def looks_transposed(x, swapped) -> bool:
     P, N = x.shape
     if P <= N or swapped.shape[0] < 2:
         return False
-    return spread(x) > 0.1 and spread(swapped) < 0.01 * spread(x)
+    # the swapped reading repeats as a periodic input does (check_record's limit), the given one
+    # does not, by a factor of 100: noise or a signal that is not periodic is never "transposed"
+    s_given, s_swapped = spread(x), spread(swapped)
+    return s_given > 0.1 and s_swapped < 0.1 and s_swapped < 0.01 * s_given
 
 
 def as_periods(x, name):

@@ -413,6 +413,14 @@ def python_cases():
              match=names("u")),
         Case("from_periods-transposed", "shape", lambda: lp().FrequencyData.from_periods(U().T, Y().T, w0=0.1),
              match=r"(?s)\bu\b.*transposed"),
+        # more periods than samples is not by itself a transposed record
+        Case("from_periods-many-short-periods", "value", lambda: lp().FrequencyData.from_periods(
+            lp().multisine([1, 2], 8, seed=0).periods(100) + 1e-3 * np.random.default_rng(0).standard_normal((100, 8)),
+            lp().multisine([1, 2], 8, seed=0).periods(100), w0=1.0),
+             check=lambda d: d.periods == 100 and np.isclose(abs(d.U[1]), 0.5, rtol=1e-3)),
+        Case("from_periods-many-noise-periods", "value", lambda: lp().FrequencyData.from_periods(
+            np.random.default_rng(0).standard_normal((1000, 4)), np.random.default_rng(1).standard_normal((1000, 4)),
+            w0=1.0), check=lambda d: d.periods == 1000),
         Case("from_periods-shape-mismatch", "shape",
              lambda: lp().FrequencyData.from_periods(U(), Y()[:, :128], w0=0.1), match=names("u and y")),
     ]
