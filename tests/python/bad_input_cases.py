@@ -793,7 +793,8 @@ def cli_cases():
                 argv += [opt, v]
             if opt == "--samples":
                 argv += ["--model", "{dir}/model.json", "--excited", "1-10"]
-            add(f"montecarlo-{opt[2:]}-{v}", argv, opt)
+            # lptv.montecarlo's own message names its argument 'methods', which --method sets
+            add(f"montecarlo-{opt[2:]}-{v}", argv, r"(\bmethods?\b)" if opt == "--method" else opt)
     for f in ("none.json", "junk.json", "text.json", "v999.json"):
         add(f"montecarlo-model-{f}", mc + ("--model", "{dir}/" + f, "--excited", "1-10"), f)
     add("montecarlo-excited-huge", mc + ("--model", "{dir}/model.json", "--excited", "1-99999999999"), "--excited")

@@ -114,7 +114,10 @@ def run(args) -> int:
         if args.refine < 0:
             raise FileError(f"--refine must be >= 0, got {args.refine}")
         integer(args.refine, "--refine")
-        output_folder(args.out)
+        try:
+            output_folder(args.out)
+        except OSError as e:
+            raise FileError(f"{e.filename or args.out}: {e.strerror or e}") from None
         executor, workers = executor_of(args)
         meas = read_measurements(src, args.periods)
         w0 = _w0(args, meas)

@@ -110,7 +110,6 @@ def _run(parser, args) -> int:
         if args.periods < 2:
             parser.error("--periods must be >= 2")
         from lptv.apps.options import INT_MAX, output_folder
-        from lptv.measurements import FileError
 
         for opt, v in (("--monte-carlo", args.monte_carlo), ("--periods", args.periods)):
             if v > INT_MAX:
@@ -123,8 +122,8 @@ def _run(parser, args) -> int:
             return 2
         try:
             output_folder(args.out)
-        except FileError as e:
-            parser.error(str(e))
+        except OSError as e:
+            parser.error(f"--out {e.filename or args.out}: {e.strerror or e}")
         if args.case == "lecture":
             from lptv.apps import lecture
 

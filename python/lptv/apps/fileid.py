@@ -208,6 +208,10 @@ def run(args) -> int:
         return manyid.run(args)
     src = args.files[0]
     try:
+        output_folder(args.out)
+    except OSError as e:
+        return _fail(e.filename or args.out, e.strerror or e)
+    try:
         lines = parse_lines(args.lines) if args.lines is not None else None
         ka, kb, known = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb"), parse_known(args.known)
         if args.max_iter < 0:
@@ -215,7 +219,6 @@ def run(args) -> int:
         for opt in ("na", "nb", "max_iter"):
             integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         positive(args.tol, "--tol")
-        output_folder(args.out)
         period = None
         if args.fs is not None or args.dt is not None:
             period = positive(args.period, "--period")

@@ -75,7 +75,7 @@ def add_parser(sub):
     return p
 
 
-OPTION_NAMES = {"runs": "--runs", "periods": "--periods", "methods": "--method", "snr_in_db": "--snr-in",
+OPTION_NAMES = {"runs": "--runs", "periods": "--periods", "snr_in_db": "--snr-in",
                 "snr_out_db": "--snr-out", "pole_in": "--pole-in", "pole_out": "--pole-out",
                 "correlation": "--correlation", "seed": "--seed", "chunk_size": "--chunk-size",
                 "lines": "--lines", "n_samples": "--samples", "workers": "--workers"}

@@ -4,13 +4,16 @@ Every bad option value ends in one line on stderr and exit status 2, never a usa
 traceback: argparse's own errors go through :class:`Parser`; a message of the library that names
 a Python argument (``max_iter must be ...``) is put in the option's terms (``--max-iter must be
 ...``) by :func:`in_option_terms`; ranges of lines or grid values are bounded before they are
-expanded; an output folder given with ``--out`` is created before any work, so that a folder
+expanded; an output folder given with ``--out`` is checked before any work, so that a folder
 that cannot be written is reported at once.
 """
 from __future__ import annotations
 
 import argparse
+import errno
+import os
 import re
+import tempfile
 from pathlib import Path
 
 from lptv.measurements import FileError
@@ -50,14 +53,24 @@ def bounded_range(lo: int, hi: int, opt: str, token: str, limit: int = MAX_EXPAN
     return range(lo, hi + 1)
 
 
-def output_folder(path, opt="--out"):
-    """Create the folder given with ``--out`` now, before the work, or a FileError saying why not."""
+def output_folder(path):
+    """Check, before any work, that the folder given with ``--out`` can be made and written, without
+    leaving anything behind: OSError (its filename the folder) when a file stands there, or the
+    nearest existing folder above it refuses a new entry."""
     if path is None:
         return None
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise FileExistsError(errno.EEXIST, "File exists", str(path))
+    parent = p
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", str(path))
     try:
-        Path(path).mkdir(parents=True, exist_ok=True)
+        os.rmdir(tempfile.mkdtemp(prefix=".lptv-probe-", dir=parent))
     except OSError as e:
-        raise FileError(f"{opt} {path}: {e.strerror or e}") from None
+        raise OSError(e.errno, e.strerror, str(path)) from None
     return path
 
 
