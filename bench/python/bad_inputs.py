@@ -1,4 +1,5 @@
-"""Bad inputs: counts per outcome over the table of tests/python/bad_input_cases.py.
+"""Bad inputs: counts per outcome over the table of tests/python/bad_input_cases.py
+(run by tests/python/bad_input_runner.py).
 
 Runs every case of the suite tests/python/test_bad_inputs.py (the Python API in child
 interpreters, each command-line case as ``python -m lptv ...`` in its own process from scratch)
@@ -23,6 +24,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "python"))
 
 import bad_input_cases as table  # noqa: E402
+import bad_input_runner as runner  # noqa: E402
 
 LABELS = {"warning": "warning with meaningful result"}
 
@@ -37,7 +39,7 @@ def main(argv=None) -> int:
 
     t0 = time.perf_counter()
     py, cli = table.python_cases(), table.cli_cases()
-    out = table.run_all(workers=2, fork=args.fork)
+    out = runner.run_all(workers=2, fork=args.fork)
     elapsed = time.perf_counter() - t0
 
     cases = py + cli
@@ -47,17 +49,17 @@ def main(argv=None) -> int:
           f"{elapsed:.0f} s, load average {os.getloadavg()[0]:.1f}")
     print()
     print(f"{'outcome':32s} {'all':>5s} {'Python':>7s} {'CLI':>5s}")
-    for o in table.OUTCOMES:
+    for o in runner.OUTCOMES:
         n_py = sum(out[c.id][0] == o for c in py)
         n_cli = sum(out[c.id][0] == o for c in cli)
         print(f"{LABELS.get(o, o):32s} {total[o]:5d} {n_py:7d} {n_cli:5d}")
     print()
     classes = sorted({c.klass for c in cases}, key=lambda k: [c.klass for c in cases].index(k))
-    print(f"{'class of input':16s} {'cases':>5s}  " + "  ".join(LABELS.get(o, o) for o in table.OUTCOMES))
+    print(f"{'class of input':16s} {'cases':>5s}  " + "  ".join(LABELS.get(o, o) for o in runner.OUTCOMES))
     for k in classes:
         ks = [c for c in cases if c.klass == k]
         cnt = Counter(out[c.id][0] for c in ks)
-        print(f"{k:16s} {len(ks):5d}  " + "  ".join(f"{cnt[o]:{len(LABELS.get(o, o))}d}" for o in table.OUTCOMES))
+        print(f"{k:16s} {len(ks):5d}  " + "  ".join(f"{cnt[o]:{len(LABELS.get(o, o))}d}" for o in runner.OUTCOMES))
     wrong = [c for c in cases if out[c.id][0] != c.expected]
     print()
     print(f"cases whose outcome is not the expected one: {len(wrong)}")

@@ -1,5 +1,6 @@
 """Every bad input through the public Python API and the command line gives a clear error naming
-the argument (or the option, or the file): the table of cases is bad_input_cases.py.
+the argument (or the option, or the file): the table of cases is bad_input_cases.py, run by
+bad_input_runner.py.
 
 Python cases run in child interpreters (a crash there fails its case, not the session); each
 command-line case runs in its own process and must exit with status 2 and one line on stderr,
@@ -10,6 +11,7 @@ import argparse
 import pytest
 
 import bad_input_cases as table
+import bad_input_runner as runner
 import lptv
 
 PY = table.python_cases()
@@ -22,13 +24,13 @@ def py_outcomes():
 
     ids = [c.id for c in PY]
     with ThreadPoolExecutor(2) as ex:   # two child interpreters side by side
-        parts = list(ex.map(table.run_python_cases, [ids[0::2], ids[1::2]]))
+        parts = list(ex.map(runner.run_python_cases, [ids[0::2], ids[1::2]]))
     return {**parts[0], **parts[1]}
 
 
 @pytest.fixture(scope="module")
 def cli_outcomes():
-    return table.run_cli_cases(CLI, workers=2)
+    return runner.run_cli_cases(CLI, workers=2)
 
 
 @pytest.mark.parametrize("case", PY, ids=[c.id for c in PY])
@@ -89,14 +91,14 @@ def test_every_class_of_bad_value_is_present(klass):
 # ----------------------------------------------------------------------- the runner itself
 
 def test_the_runner_reports_a_crash_and_goes_on():
-    out = table.run_python_cases([table.SELFTEST_CRASH, "Model-w0-str"])
-    assert out[table.SELFTEST_CRASH][0] == "crash"
+    out = runner.run_python_cases([runner.SELFTEST_CRASH, "Model-w0-str"])
+    assert out[runner.SELFTEST_CRASH][0] == "crash"
     assert out["Model-w0-str"][0] == "clear error"
 
 
 def test_the_runner_reports_a_silent_wrong_result():
-    out = table.run_python_cases([table.SELFTEST_SILENT])
-    assert out[table.SELFTEST_SILENT][0] == "silent wrong result"
+    out = runner.run_python_cases([runner.SELFTEST_SILENT])
+    assert out[runner.SELFTEST_SILENT][0] == "silent wrong result"
 
 
 def test_classify_tells_unclear_from_clear_errors():
@@ -104,14 +106,14 @@ def test_classify_tells_unclear_from_clear_errors():
         raise exc
 
     case = table.Case("x", "type", lambda: raises(ValueError("w0 must be a number")), match=table.names("w0"))
-    assert table.classify(case)[0] == "clear error"
+    assert runner.classify(case)[0] == "clear error"
     case = table.Case("x", "type", lambda: raises(TypeError("w0 must be a number")), match=table.names("w0"))
-    assert table.classify(case)[0] == "unclear error"            # the wrong type
+    assert runner.classify(case)[0] == "unclear error"            # the wrong type
     case = table.Case("x", "type", lambda: raises(ValueError("could not convert string to float: 'abc'")),
                       match=table.names("w0"))
-    assert table.classify(case)[0] == "unclear error"            # does not name w0
+    assert runner.classify(case)[0] == "unclear error"            # does not name w0
     case = table.Case("x", "value", lambda: 2.0, check=lambda v: v == 3.0)
-    assert table.classify(case)[0] == "silent wrong result"      # a wrong answer
+    assert runner.classify(case)[0] == "silent wrong result"      # a wrong answer
 
 
 @pytest.mark.parametrize("status, stderr, outcome", [
@@ -126,7 +128,7 @@ def test_classify_tells_unclear_from_clear_errors():
 ])
 def test_the_command_line_judge(status, stderr, outcome):
     case = table.Case("x", "cli", argv=("identify",), match="--na")
-    assert table._judge(case, status, stderr)[0] == outcome
+    assert runner._judge(case, status, stderr)[0] == outcome
 
 
 def test_forked_commands_agree_with_python_m_lptv(tmp_path):
@@ -138,6 +140,6 @@ def test_forked_commands_agree_with_python_m_lptv(tmp_path):
         "cli-identify-file-transposed.npz"}]
     assert len(sample) == 8
     table.cli_files(tmp_path)
-    forked = table.run_cli_cases(sample, workers=2)
+    forked = runner.run_cli_cases(sample, workers=2)
     for c in sample:
-        assert table.run_cli_case(c, tmp_path)[0] == forked[c.id][0] == "clear error", c.id
+        assert runner.run_cli_case(c, tmp_path)[0] == forked[c.id][0] == "clear error", c.id
