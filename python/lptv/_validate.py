@@ -112,8 +112,9 @@ def as_spectrum(x, name):
 
 
 def _is_real_number(x) -> bool:
+    # a one-element array counts as its number, as float() takes it (w0 read from a .mat file is 1 x 1)
     return (isinstance(x, (int, float, np.integer, np.floating))
-            or (isinstance(x, np.ndarray) and x.ndim == 0 and x.dtype.kind in "iuf")) \
+            or (isinstance(x, np.ndarray) and x.size == 1 and x.dtype.kind in "iuf")) \
         and not isinstance(x, (bool, np.bool_))
 
 
@@ -126,7 +127,7 @@ def as_float(x, name, *, minimum=None, maximum=None, open_min=False, open_max=Fa
         what = "a finite real number" if finite else "a real number (not NaN)"
     if not _is_real_number(x):
         raise ValueError(f"{name} must be {what}, got {x!r}")
-    v = float(x)
+    v = float(x.reshape(-1)[0]) if isinstance(x, np.ndarray) else float(x)
     if np.isnan(v) or (finite and not np.isfinite(v)):
         raise ValueError(f"{name} must be {what}, got {x!r}")
     lo_bad = minimum is not None and (v < minimum or (open_min and v == minimum))

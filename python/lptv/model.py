@@ -247,9 +247,9 @@ class Model:
 
     def frozen(self, t: float):
         """The frozen polynomials at time t: (num, den), highest power first (numpy.roots order)."""
-        if np.ndim(t) != 0:
-            raise ValueError(f"t must be one time (s), got shape {np.shape(t)}: use a_at / b_at for many")
-        tt = as_real_1d(t, "t")
+        if isinstance(t, (str, bytes)) or np.size(t) != 1:
+            raise ValueError(f"t must be one time (s), got {t!r}: use a_at / b_at for many times")
+        tt = as_real_1d(np.reshape(t, 1) if isinstance(t, np.ndarray) else t, "t")
         return self.b_at(tt)[0][::-1].copy(), self.a_at(tt)[0][::-1].copy()
 
     # -- persistence -------------------------------------------------------------
