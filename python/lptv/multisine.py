@@ -76,10 +76,12 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
         raise ValueError(f"lines must be 1-D, got shape {ln.shape}")
     if ln.dtype == object:
         try:
-            big = as_int_list(ln, "lines", minimum=-2**63, maximum=2**63)
+            vals = as_int_list(ln, "lines", minimum=-np.inf, maximum=np.inf)
         except ValueError:
             raise ValueError("lines must be integers, got non-numeric values") from None
-        raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), got {min(big)}..{max(big)}")
+        if min(vals) < 0 or max(vals) > n_samples // 2:
+            raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), got {min(vals)}..{max(vals)}")
+        ln = np.array(vals, dtype=np.int64)
     if not np.issubdtype(ln.dtype, np.integer):
         if not (np.issubdtype(ln.dtype, np.floating) and np.all(np.isfinite(ln))
                 and np.all(ln == np.round(ln))):

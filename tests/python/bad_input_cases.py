@@ -293,6 +293,8 @@ def python_cases():
              and np.allclose(ms.signal, _cosines(ms), atol=1e-13))
         for s in range(3)]
     C += [
+        Case("multisine-lines-object-ints", "value", lambda: lp().multisine(np.array([1, 3], dtype=object), 16, seed=0),
+             check=lambda ms: ms.lines.tolist() == [1, 3] and np.allclose(np.abs(ms.spectrum[[1, 3]]), 0.5)),
         Case("multisine-nyquist-odd-N", "value", lambda: lp().multisine([7], 15, seed=4),
              check=lambda ms: np.isclose(np.max(np.abs(np.fft.rfft(ms.signal) / 15 * 2)), 1.0, rtol=1e-12)),
         Case("Multisine.periods-fraction", "type", lambda: lp().multisine([1], 8, seed=0).periods(2.5),
