@@ -112,7 +112,7 @@ def as_spectrum(x, name):
 
 
 def _is_real_number(x) -> bool:
-    # a one-element array counts as its number, as float() takes it (w0 read from a .mat file is 1 x 1)
+    # a one-element array counts as its number (w0 read from a .mat file is 1 x 1)
     return (isinstance(x, (int, float, np.integer, np.floating))
             or (isinstance(x, np.ndarray) and x.size == 1 and x.dtype.kind in "iuf")) \
         and not isinstance(x, (bool, np.bool_))
