@@ -86,7 +86,7 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
         if not (np.issubdtype(ln.dtype, np.floating) and np.all(np.isfinite(ln))
                 and np.all(ln == np.round(ln))):
             raise ValueError(f"lines must be integers, got {ln.dtype} values")
-        if np.any(np.abs(ln) > 2**62):
+        if np.any(np.abs(ln.astype(np.float64)) > 2.0**62):
             raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), got {ln.min():.0f}..{ln.max():.0f}")
         ln = ln.astype(np.int64)
     if np.any(ln < 0) or np.any(ln > n_samples // 2):
