@@ -19,13 +19,14 @@ from __future__ import annotations
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import warnings
 from pathlib import Path
 
-from bad_input_cases import Case, _lptv, cli_cases, cli_files, python_cases
+from bad_input_cases import Case, _lptv, cli_cases, cli_files, folder, python_cases
 
 OUTCOMES = ("clear error", "warning", "correct result", "unclear error", "silent wrong result", "crash")
 
@@ -94,6 +95,8 @@ def _child(ids):
             outcome, detail = "crash", str(e)
         signal.alarm(0)
         print(json.dumps({"id": i, "outcome": outcome, "detail": detail}), flush=True)
+    if folder.cache_info().currsize:
+        shutil.rmtree(folder(), ignore_errors=True)
 
 
 SELFTEST_CRASH = "_selftest-crash"
@@ -219,7 +222,16 @@ def run_cli_cases(cases, workers=2, fork=True):
     from concurrent.futures import ThreadPoolExecutor
 
     d = Path(tempfile.mkdtemp(prefix="lptv-bad-cli-"))
-    cli_files(d)
+    try:
+        cli_files(d)
+        return _run_cli_cases(cases, workers, fork, d)
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def _run_cli_cases(cases, workers, fork, d):
+    from concurrent.futures import ThreadPoolExecutor
+
     if not fork:
         with ThreadPoolExecutor(workers) as ex:
             results = list(ex.map(lambda c: run_cli_case(c, d), cases))
