@@ -1,5 +1,16 @@
-"""Input checks shared by the Python layer: every message names its argument."""
+"""Input checks shared by the Python layer: every message names its argument.
+
+Every public function and constructor converts its arguments here, so that a wrong type, NaN or
+inf, a wrong shape or size, a value out of range or beyond the core's C int gives a ValueError
+whose message names the argument and says what was wrong (never a TypeError from deep inside
+NumPy, an OverflowError, a silent truncation of 2.5 to 2, or a number wrapped around in 32 bits).
+ValueError is used for wrong types too, consistently, as the layer always has.
+"""
 from __future__ import annotations
+
+import json
+import os
+from typing import Optional
 
 import numpy as np
 
@@ -20,7 +31,7 @@ INT_MAX = 2**31 - 1  # the core indexes lines and samples with C int
 
 def as_int(x, name, minimum=0, maximum=INT_MAX):
     """A whole number in [minimum, maximum], or a ValueError naming the argument."""
-    if isinstance(x, (bool, np.bool_)) or np.ndim(x) != 0:
+    if isinstance(x, (bool, np.bool_, str, bytes)) or np.ndim(x) != 0:
         raise ValueError(f"{name} must be an integer, got {x!r}")
     try:
         v = float(x) if not isinstance(x, (int, np.integer)) else x
@@ -45,11 +56,8 @@ def as_str(x, name, choices):
 
 
 def as_positive_float(x, name):
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be positive and finite, got {x!r}") from None
-    if not (np.isfinite(v) and v > 0):
+    v = as_float(x, name, what="positive and finite")
+    if not v > 0:
         raise ValueError(f"{name} must be positive and finite, got {x!r}")
     return v
 
@@ -101,3 +109,167 @@ def as_spectrum(x, name):
     arr = arr.astype(complex)
     check_finite(arr, name)
     return arr, was_1d
+
+
+def _is_real_number(x) -> bool:
+    # a one-element array counts as its number (w0 read from a .mat file is 1 x 1)
+    return (isinstance(x, (int, float, np.integer, np.floating))
+            or (isinstance(x, np.ndarray) and x.size == 1 and x.dtype.kind in "iuf")) \
+        and not isinstance(x, (bool, np.bool_))
+
+
+def as_float(x, name, *, minimum=None, maximum=None, open_min=False, open_max=False,
+             finite=True, what=None):
+    """A real number (float), optionally within [minimum, maximum] (open ends on request), or a
+    ValueError naming the argument: strings, None, complex, bools and sequences are refused."""
+    custom = what is not None
+    if what is None:
+        what = "a finite real number" if finite else "a real number (not NaN)"
+    if not _is_real_number(x):
+        raise ValueError(f"{name} must be {what}, got {x!r}")
+    v = float(x.reshape(-1)[0]) if isinstance(x, np.ndarray) else float(x)
+    if np.isnan(v) or (finite and not np.isfinite(v)):
+        raise ValueError(f"{name} must be {what}, got {x!r}")
+    lo_bad = minimum is not None and (v < minimum or (open_min and v == minimum))
+    hi_bad = maximum is not None and (v > maximum or (open_max and v == maximum))
+    if (lo_bad or hi_bad) and custom:
+        raise ValueError(f"{name} must be {what}, got {x!r}")
+    if lo_bad or hi_bad:
+        if minimum is not None and maximum is not None:
+            rng = f"in {'(' if open_min else '['}{minimum:g}, {maximum:g}{')' if open_max else ']'}"
+        elif minimum is not None:
+            rng = f"{'>' if open_min else '>='} {minimum:g}"
+        else:
+            rng = f"{'<' if open_max else '<='} {maximum:g}"
+        raise ValueError(f"{name} must be {rng}, got {x!r}")
+    return v
+
+
+def as_optional(x, convert, *args, **kwargs):
+    """None stays None; anything else goes through ``convert(x, *args, **kwargs)``."""
+    return None if x is None else convert(x, *args, **kwargs)
+
+
+def as_bool(x, name):
+    """True or False (also NumPy's bool and the integers 0 and 1); strings, NaN and the rest are
+    refused rather than judged by their truth value ('no' is true)."""
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)) and x in (0, 1):
+        return bool(x)
+    raise ValueError(f"{name} must be True or False, got {x!r}")
+
+
+def as_path(x, name="path"):
+    """A file path (str or os.PathLike) as a str."""
+    if not isinstance(x, (str, os.PathLike)):
+        raise ValueError(f"{name} must be a file path (str or os.PathLike), got {type(x).__name__}")
+    p = os.fspath(x)
+    if not isinstance(p, str) or not p:
+        raise ValueError(f"{name} must be a non-empty file path, got {x!r}")
+    return p
+
+
+def load_json(path, name="path"):
+    """The JSON document in a file; a file that is not JSON text (binary data, another format) is a
+    ValueError naming the file, and a missing file the usual OSError (FileNotFoundError)."""
+    p = as_path(path, name)
+    with open(p, "rb") as f:
+        raw = f.read()
+    try:
+        return json.loads(raw.decode("utf-8-sig"))
+    except UnicodeDecodeError:
+        raise ValueError(f"{p}: not a JSON file (binary data that is not UTF-8 text)") from None
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{p}: not valid JSON ({e})") from None
+
+
+def as_seed(seed, name="seed"):
+    """A numpy Generator from None, a non-negative integer (or a sequence of them), a SeedSequence,
+    a BitGenerator or a Generator."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, (bool, np.bool_, float, np.floating, complex, str, bytes)):
+        raise ValueError(f"{name} must be None, a non-negative integer or a numpy Generator, got {seed!r}")
+    try:
+        return np.random.default_rng(seed)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name} must be None, a non-negative integer or a numpy Generator, got {seed!r} "
+                         f"({e})") from None
+
+
+def as_int_list(x, name, minimum=0, maximum=INT_MAX):
+    """A 1-D sequence of whole numbers, each in [minimum, maximum], as a list of int."""
+    if isinstance(x, (str, bytes)) or np.ndim(x) != 1:
+        shape = "a string" if isinstance(x, (str, bytes)) else f"shape {np.shape(x)}"
+        raise ValueError(f"{name} must be a 1-D sequence of integers, got {shape}")
+    try:
+        items = list(x)
+    except TypeError:
+        raise ValueError(f"{name} must be a 1-D sequence of integers, got {x!r}") from None
+    out = []
+    for v in items:
+        try:
+            out.append(as_int(v, name, minimum=minimum, maximum=maximum))
+        except ValueError as e:
+            raise ValueError(f"{e} (an entry of {name})") from None
+    return out
+
+
+def as_lines(x, name="lines", minimum=0, maximum=INT_MAX):
+    """A non-empty 1-D sequence of line numbers (whole, non-negative, within the core's int)."""
+    if isinstance(x, (int, np.integer)):
+        raise ValueError(f"{name} must be a sequence of line numbers, got the single integer {x!r}")
+    rows = as_int_list(x, name, minimum=minimum, maximum=maximum)
+    if not rows:
+        raise ValueError(f"{name} must be a non-empty 1-D sequence of integers")
+    return rows
+
+
+def as_counts(k, n, name):
+    """Harmonic counts: one integer for all n+1 coefficients, or one per coefficient."""
+    if np.ndim(k) == 0 and not isinstance(k, (str, bytes)):
+        return [as_int(k, name)] * (n + 1)
+    ks = as_int_list(k, name)
+    if len(ks) != n + 1:
+        raise ValueError(f"{name} must give one harmonic count per coefficient ({n + 1}), got {len(ks)}")
+    return ks
+
+
+def spread(x):
+    """Mean variance over the rows (periods) over the power of the mean row: small for a periodic
+    signal cut at its period, about 1 or more for anything else (inf for a zero mean row)."""
+    mean_power = float(np.mean(x.mean(axis=0) ** 2))
+    if x.shape[0] < 2:
+        return np.inf
+    return float(x.var(axis=0, ddof=1).mean() / mean_power) if mean_power > 0 else np.inf
+
+
+def looks_transposed(x, swapped) -> bool:
+    """More periods than samples per period, no repetition from period to period, while the
+    swapped reading (the same samples as ``swapped``) repeats: a record given as samples x
+    periods, or split with the counts exchanged."""
+    P, N = x.shape
+    if P <= N or swapped.shape[0] < 2:
+        return False
+    # the swapped reading repeats as a periodic input does (check_record's limit), the given one
+    # does not, by a factor of 100: noise or a signal that is not periodic is never "transposed"
+    s_given, s_swapped = spread(x), spread(swapped)
+    return s_given > 0.1 and s_swapped < 0.1 and s_swapped < 0.01 * s_given
+
+
+def as_periods(x, name):
+    """P periods of N samples, shape (P, N), real and finite; a record that looks transposed is
+    refused with a message saying so."""
+    arr = _array(x, name)
+    if np.iscomplexobj(arr):
+        raise ValueError(f"{name} must be a real time signal, got complex values")
+    if arr.ndim != 2:
+        raise ValueError(f"{name} must have shape (P, N): P periods of N samples, got shape {arr.shape}")
+    check_finite(arr, name)
+    arr = np.ascontiguousarray(arr, dtype=float)
+    if looks_transposed(arr, arr.T):
+        P, N = arr.shape
+        raise ValueError(f"{name} looks transposed: {P} periods of {N} samples do not repeat, but its "
+                         f"{N} columns do; pass the record as (P, N) = periods x samples ({name}.T)")
+    return arr

@@ -6,22 +6,31 @@ from typing import Optional
 import numpy as np
 
 from . import _core
-from ._validate import check_finite
+from ._validate import _array, as_float, as_int, as_optional, as_periods, check_finite
+
+_periods_array = as_periods  # the name measurements.check_record imports
 
 
-def _periods_array(x, name):
-    try:
-        arr = np.asarray(x)
-    except Exception as e:
-        raise ValueError(f"{name} must be array-like: {e}") from None
-    if arr.dtype == object or not np.issubdtype(arr.dtype, np.number):
-        raise ValueError(f"{name} must be numeric, got dtype {arr.dtype}")
-    if np.iscomplexobj(arr):
-        raise ValueError(f"{name} must be a real time signal, got complex values")
-    if arr.ndim != 2:
-        raise ValueError(f"{name} must have shape (P, N): P periods of N samples, got shape {arr.shape}")
-    check_finite(arr, name)
-    return np.ascontiguousarray(arr, dtype=float)
+def _line_vector(x, name, n, dtype):
+    """One value per line 0..L (1-D, numeric, finite); n = None takes the length from x."""
+    a = _array(x, name)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be 1-D, one value per line 0..L, got shape {a.shape}")
+    if n is not None and a.size != n:
+        raise ValueError(f"{name} must be 1-D with {n} lines like U, got shape {a.shape}")
+    if a.size == 0:
+        raise ValueError(f"{name} must not be empty (one value per line 0..L)")
+    if dtype is float and np.iscomplexobj(a):
+        raise ValueError(f"{name} must be real (a variance), got complex values")
+    a = a.astype(dtype)
+    check_finite(a, name)
+    return a
+
+
+def _real_dc(X, name):
+    scale = max(float(np.abs(X).max()), 1e-300)
+    if abs(X[0].imag) > 1e-12 * scale:
+        raise ValueError(f"{name}: line 0 (DC) must be real for a real signal, got {X[0]}")
 
 
 class FrequencyData:
@@ -43,35 +52,37 @@ class FrequencyData:
 
     def __init__(self, U, Y, varU, varY, covYU=None, *, w0: float, ts: Optional[float] = None,
                  periods: int = 0):
-        U = np.asarray(U, dtype=complex).ravel()
+        U = _line_vector(U, "U", None, complex)
         n = U.size
-        def vec(x, name, dtype):
-            a = np.asarray(x)
-            if a.dtype == object or not np.issubdtype(a.dtype, np.number):
-                raise ValueError(f"{name} must be numeric, got dtype {a.dtype}")
-            if a.ndim != 1 or a.size != n:
-                raise ValueError(f"{name} must be 1-D with {n} lines like U, got shape {a.shape}")
-            if dtype is float and np.iscomplexobj(a):
-                raise ValueError(f"{name} must be real (a variance), got complex values")
-            a = a.astype(dtype)
-            check_finite(a, name)
-            return a
-        Y = vec(Y, "Y", complex)
-        varU = vec(varU, "varU", float)
-        varY = vec(varY, "varY", float)
-        covYU = np.zeros(n, complex) if covYU is None else vec(covYU, "covYU", complex)
-        check_finite(U, "U")
+        Y = _line_vector(Y, "Y", n, complex)
+        varU = _line_vector(varU, "varU", n, float)
+        varY = _line_vector(varY, "varY", n, float)
+        covYU = np.zeros(n, complex) if covYU is None else _line_vector(covYU, "covYU", n, complex)
+        _real_dc(U, "U")
+        _real_dc(Y, "Y")
         if np.any(varU < 0):
             raise ValueError("varU must be >= 0 (a variance)")
         if np.any(varY < 0):
             raise ValueError("varY must be >= 0 (a variance)")
-        self._set(_core.FrequencyData(U, Y, varU, varY, covYU, int(periods)), w0, ts)
+        bad = np.flatnonzero(np.abs(covYU) ** 2 > varU * varY * (1 + 1e-12))
+        if bad.size:
+            raise ValueError(f"covYU: |covYU|^2 must not exceed varU * varY (a covariance), not so on line {bad[0]}")
+        periods = as_int(periods, "periods")
+        if periods == 1:
+            raise ValueError("periods must be 0 (statistics from elsewhere) or >= 2 (the periods the "
+                             "variances were estimated from), got 1")
+        w0, ts = self._check(w0, ts)
+        self._set(_core.FrequencyData(U, Y, varU, varY, covYU, periods), w0, ts)
+
+    @staticmethod
+    def _check(w0, ts):
+        w0 = as_float(w0, "w0", minimum=0.0, open_min=True,
+                      what="a finite positive angular frequency (rad/s)")
+        ts = as_optional(ts, as_float, "ts", minimum=0.0, open_min=True, what="a positive sample period or None")
+        return w0, ts
 
     def _set(self, cpp, w0, ts):
-        if w0 is None or not np.isfinite(w0) or w0 <= 0:
-            raise ValueError(f"w0 must be a finite positive angular frequency (rad/s), got {w0!r}")
-        if ts is not None and (not np.isfinite(ts) or ts <= 0):
-            raise ValueError(f"ts must be a positive sample period or None, got {ts!r}")
+        w0, ts = self._check(w0, ts)
         self._cpp = cpp
         self.w0 = float(w0)
         self.ts = None if ts is None else float(ts)
@@ -89,13 +100,14 @@ class FrequencyData:
         ts : float, optional
             Sample period for a discrete-time model (N * ts * w0 = 2 pi).
         """
+        w0, ts = cls._check(w0, ts)
         u = _periods_array(u, "u")
         y = _periods_array(y, "y")
         if u.shape != y.shape:
             raise ValueError(f"u and y must have the same shape (P, N), got {u.shape} and {y.shape}")
         if u.shape[0] < 2:
             raise ValueError(f"u, y: at least 2 periods are needed for a noise model, got P = {u.shape[0]}")
-        if ts is not None and w0 is not None and np.isfinite(ts) and np.isfinite(w0) and ts > 0 and w0 > 0:
+        if ts is not None:
             n_expected = 2 * np.pi / (w0 * ts)
             if abs(n_expected - u.shape[1]) > 1e-6 * u.shape[1]:
                 raise ValueError(f"u, y: {u.shape[1]} samples per period, but w0 = {w0:g} and ts = {ts:g} "
@@ -125,9 +137,9 @@ def frequency_data_of(u, y, w0, ts) -> "FrequencyData":
     if isinstance(u, FrequencyData):
         if y is not None:
             raise ValueError("y must be omitted when u is a FrequencyData")
-        if w0 is not None and not np.isclose(w0, u.w0):
+        if w0 is not None and not np.isclose(as_float(w0, "w0"), u.w0):
             raise ValueError(f"w0={w0} disagrees with the data's w0={u.w0}")
-        if ts is not None and u.ts is not None and not np.isclose(ts, u.ts):
+        if ts is not None and u.ts is not None and not np.isclose(as_float(ts, "ts"), u.ts):
             raise ValueError(f"ts={ts} disagrees with the data's ts={u.ts}")
         return u
     if y is None:

@@ -8,7 +8,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_positive_float, as_spectrum, as_str
+from ._validate import as_bool, as_int, as_positive_float, as_spectrum, as_str
 
 SOLVERS = ("auto", "band", "klu", "umfpack")
 from .floquet import UnstableModelWarning, unstable_warning_text
@@ -134,8 +134,8 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     max_guard = -1 if max_guard is None else as_int(max_guard, "max_guard")
     tol = as_positive_float(tol, "tol")
     solver = as_str(solver, "solver", SOLVERS)
-    if not isinstance(warn_unstable, (bool, np.bool_)):
-        raise TypeError(f"warn_unstable must be True or False, got {type(warn_unstable).__name__}")
+    full_output = as_bool(full_output, "full_output")
+    warn_unstable = as_bool(warn_unstable, "warn_unstable")
     r = _core.simulate(model._cpp, Ua, solver=solver, lines_out=lines_out, guard=guard, tol=tol,
                        max_guard=max_guard)
     Y = np.asarray(r["Y"])

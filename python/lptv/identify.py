@@ -13,7 +13,7 @@ from . import _core
 from .data import FrequencyData, experiments_of, frequency_data_of
 from .floquet import UnstableModelWarning, unstable_warning_text
 from .model import Model
-from ._validate import as_positive_float
+from ._validate import as_counts, as_float, as_int, as_lines, as_positive_float
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 
@@ -344,17 +344,7 @@ class IdentificationResult:
 
 
 def _counts(k, n, name):
-    if np.ndim(k) == 0:
-        if int(k) != k or k < 0:
-            raise ValueError(f"{name} must be a non-negative integer or one per coefficient, got {k!r}")
-        return [int(k)] * (n + 1)
-    ks = list(k)
-    if len(ks) != n + 1:
-        raise ValueError(f"{name} must give one harmonic count per coefficient ({n + 1}), got {len(ks)}")
-    for v in ks:
-        if int(v) != v or v < 0:
-            raise ValueError(f"{name}: harmonic counts must be non-negative integers, got {ks}")
-    return [int(v) for v in ks]
+    return as_counts(k, n, name)
 
 
 def _known_list(known, ka, kb):
@@ -391,18 +381,7 @@ def _known_list(known, ka, kb):
 
 
 def _rows(lines):
-    try:
-        rows = np.asarray(list(lines) if not isinstance(lines, np.ndarray) else lines)
-    except TypeError:
-        raise ValueError(f"lines must be a sequence of integers, got {lines!r}") from None
-    if rows.ndim != 1 or rows.size == 0:
-        raise ValueError("lines must be a non-empty 1-D sequence of integers")
-    if not np.issubdtype(rows.dtype, np.integer):
-        if np.issubdtype(rows.dtype, np.floating) and np.all(rows == np.round(rows)):
-            rows = rows.astype(int)
-        else:
-            raise ValueError(f"lines must be integers, got dtype {rows.dtype}")
-    return [int(r) for r in rows]
+    return as_lines(lines, "lines")
 
 
 _DEFAULT_LINES = "excited"  # what lines=None means: the usable lines K+1..Lmax-K
@@ -514,8 +493,11 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     >>> np.round(res.model.a[:, 0].real, 2)
     array([2., 1.])
     """
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    na, nb = as_int(na, "na"), as_int(nb, "nb")
+    tol = as_float(tol, "tol", minimum=0.0, open_min=True)
+    max_iter = as_int(max_iter, "max_iter")
     several = y is None and isinstance(u, (list, tuple))
     if several:
         datas = experiments_of(u, w0, ts)
@@ -523,14 +505,6 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     else:
         data = frequency_data_of(u, y, w0, ts)
     ts = data.ts if ts is None else ts
-    for name, v in (("na", na), ("nb", nb)):
-        if np.ndim(v) != 0 or int(v) != v or v < 0:
-            raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be > 0, got {tol!r}")
-    if int(max_iter) != max_iter or max_iter < 0:
-        raise ValueError(f"max_iter must be a non-negative integer, got {max_iter!r}")
-    na, nb = int(na), int(nb)
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))

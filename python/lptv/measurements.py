@@ -26,6 +26,8 @@ from typing import Optional, Tuple
 
 import numpy as np
 
+from ._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
+
 FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
 _MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
                    "int64", "uint64"}
@@ -35,8 +37,8 @@ def _one_line(e):
     return " ".join(str(e).split()) or type(e).__name__
 
 
-class FileError(Exception):
-    """A problem with the input file or the options that the user can act on."""
+class FileError(ValueError):
+    """A problem with the input file or the options that the user can act on (a ValueError)."""
 
 
 @dataclass(frozen=True)
@@ -98,7 +100,14 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     >>> m.u.shape, m.trimmed, m.skipped
     ((9, 100), 50, 1)
     """
-    path = Path(path)
+    path = Path(as_path(path))
+    periods = as_optional(periods, _option, as_int, "--periods", minimum=1)
+    fs = as_optional(fs, _option, as_float, "--fs", minimum=0.0, open_min=True, what="a positive number")
+    dt = as_optional(dt, _option, as_float, "--dt", minimum=0.0, open_min=True, what="a positive number")
+    period = as_optional(period, _option, as_float, "--period", minimum=0.0, open_min=True,
+                         what="a positive number")
+    trim = _option(trim, as_bool, "--trim")
+    skip_periods = _option(skip_periods, as_int, "--skip-periods")
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
         raise FileError(f"unknown file type '{path.suffix}' (expected .csv, .npz or .mat)")
@@ -106,14 +115,7 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         raise FileError("no such file")
     if path.is_dir():
         raise FileError("is a directory, not a measurement file")
-    if periods is not None and periods < 1:
-        raise FileError(f"--periods must be a positive integer, got {periods}")
     fs = _sampling(fs, dt)
-    if period is not None and not (np.isfinite(period) and period > 0):
-        raise FileError(f"--period must be a positive number, got {period!r}")
-    skip_periods = int(skip_periods)
-    if skip_periods < 0:
-        raise FileError(f"--skip-periods must be >= 0, got {skip_periods}")
     split = _Split(periods, fs, period, trim)
     if fmt == "CSV":
         u, y, w0 = _read_csv(path, split)
@@ -133,6 +135,14 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
                             f"{u.shape[0]} periods; the noise model needs at least 2")
         u, y = u[skip_periods:], y[skip_periods:]
     return Measurements(u=u, y=y, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods)
+
+
+def _option(x, convert, name, **kw):
+    """An argument through a _validate conversion, its ValueError as a FileError."""
+    try:
+        return convert(x, name, **kw)
+    except ValueError as e:
+        raise FileError(str(e)) from None
 
 
 def _sampling(fs, dt):
@@ -251,8 +261,25 @@ def _read_csv(path, split):
     if split.periods is None and split.n() is None:
         raise FileError(f"--periods is required for a CSV record (how many periods its "
                         f"{len(line_of)} samples hold), or --fs with --period")
-    return (split.vector("column 'u'", np.array(values["u"])),
-            split.vector("column 'y'", np.array(values["y"])), None)
+    u = split.vector("column 'u'", np.array(values["u"]))
+    _not_transposed("column 'u'", u, np.array(values["u"]), split)
+    return u, split.vector("column 'y'", np.array(values["y"])), None
+
+
+def _not_transposed(what, a, samples, split):
+    """A record split into more periods than samples per period that does not repeat, while the
+    other reading of the same numbers does: the counts are exchanged (or the array transposed)."""
+    P, N = a.shape
+    if P <= N:
+        return
+    if samples is None:      # a 2-D variable: the other reading is its transpose
+        other, how = a.T, f"the array looks transposed: store it as {N} x {P} (periods x samples)"
+    else:                     # a vector split into P periods: the other reading is N periods
+        other = samples[split.trimmed:].reshape(N, P)
+        how = (f"the record looks transposed (the counts exchanged): it repeats as {N} periods of {P} "
+               "samples; --periods is the number of periods")
+    if looks_transposed(a, other):
+        raise FileError(f"{what} read as {P} periods of {N} samples does not repeat from period to period; {how}")
 
 
 def _delimiter(text):
@@ -295,8 +322,12 @@ def _as_periods(name, a, split):
         if v is None:
             raise FileError(f"{what} is a vector of {a.size} samples: give --periods, "
                             "the number of periods it holds (or --fs with the period)")
+        if np.all(np.isfinite(v)) and name == "u":
+            _not_transposed(what, v, a.ravel(), split)
         a = v
     else:
+        if np.all(np.isfinite(a)) and name == "u" and (periods is None or a.shape[0] == periods):
+            _not_transposed(what, a, None, split)
         if periods is not None and a.shape[0] != periods:
             raise FileError(f"{what} holds {a.shape[0]} periods ({_shape(a)}) but --periods says {periods}")
         a = split.check_shape(name, a)
@@ -469,6 +500,8 @@ def check_record(u, y, *, warn: bool = True, spread_limit: float = 0.1) -> Recor
     """
     from .data import _periods_array
 
+    warn = as_bool(warn, "warn")
+    spread_limit = as_float(spread_limit, "spread_limit", minimum=0.0, open_min=True)
     u, y = _periods_array(u, "u"), _periods_array(y, "y")
     if u.shape != y.shape:
         raise ValueError(f"u and y must have the same shape (P, N), got {u.shape} and {y.shape}")

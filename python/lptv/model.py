@@ -8,7 +8,21 @@ from typing import Optional
 import numpy as np
 
 from . import _core
-from ._validate import as_complex_2d, as_real_1d
+from ._validate import as_complex_2d, as_float, as_int, as_path, as_real_1d, load_json
+
+FORMAT_VERSION = 1
+"""The version of the JSON description :meth:`Model.to_dict` writes and :meth:`Model.from_dict` reads."""
+_FIELDS = ("format", "version", "w0", "ts", "a_real", "a_imag", "b_real", "b_imag", "eta_names", "covariance")
+
+
+def _w0(w0):
+    return as_float(w0, "w0", minimum=0.0, open_min=True, what="a finite positive angular frequency (rad/s)")
+
+
+def _ts(ts):
+    if ts is None:
+        return 0.0
+    return as_float(ts, "ts", minimum=0.0, what="finite and >= 0 (0 or None for continuous time)")
 
 
 class Model:
@@ -51,9 +65,7 @@ class Model:
     def __init__(self, a, b, w0: float, ts: Optional[float] = None):
         a = as_complex_2d(a, "a")
         b = as_complex_2d(b, "b")
-        if ts is None:
-            ts = 0.0
-        self._cpp = _core.Model(a, b, float(w0), float(ts))
+        self._cpp = _core.Model(a, b, _w0(w0), _ts(ts))
 
     @classmethod
     def from_tf(cls, num, den, *, w0: float = 1.0, ts: Optional[float] = None) -> "Model":
@@ -84,10 +96,7 @@ class Model:
             if not self.is_lti:
                 raise ValueError("t: this model is time-varying; give the time t (s) of the frozen system")
             return 0.0
-        t = float(t)
-        if not np.isfinite(t):
-            raise ValueError(f"t must be a finite time (s), got {t!r}")
-        return t
+        return as_float(t, "t", what="a finite time (s)")
 
     def to_tf(self, t: Optional[float] = None):
         """``(num, den)`` in descending powers (scipy.signal / MATLAB order) of the LTI model, or of
@@ -146,7 +155,9 @@ class Model:
         True
         """
         w = as_real_1d(w, "w")
-        branch = int(branch)
+        branch = as_int(branch, "branch", minimum=-2**31 + 1)
+        if harmonics is not None:
+            harmonics = as_int(harmonics, "harmonics", minimum=1, maximum=4096)
         if self.is_lti:
             if branch:
                 return np.zeros(w.size, complex)
@@ -236,7 +247,9 @@ class Model:
 
     def frozen(self, t: float):
         """The frozen polynomials at time t: (num, den), highest power first (numpy.roots order)."""
-        tt = np.array([float(t)])
+        if isinstance(t, (str, bytes)) or np.size(t) != 1:
+            raise ValueError(f"t must be one time (s), got {t!r}: use a_at / b_at for many times")
+        tt = as_real_1d(np.reshape(t, 1) if isinstance(t, np.ndarray) else t, "t")
         return self.b_at(tt)[0][::-1].copy(), self.a_at(tt)[0][::-1].copy()
 
     # -- persistence -------------------------------------------------------------
@@ -250,7 +263,7 @@ class Model:
     def _to_dict(self) -> dict:
         return {
             "format": "lptv.Model",
-            "version": 1,
+            "version": FORMAT_VERSION,
             "w0": self.w0,
             "ts": self.ts,
             "a_real": self.a.real.tolist(),
@@ -261,37 +274,78 @@ class Model:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Model":
+        """The model a :meth:`to_dict` description holds; every field is checked (its type, shape,
+        finiteness, the format and version), and a wrong one is a ValueError naming it."""
         if not isinstance(d, dict) or d.get("format") != "lptv.Model":
             raise ValueError("not an lptv.Model description (missing format: 'lptv.Model')")
+        unknown = [k for k in d if k not in _FIELDS]
+        if unknown:
+            raise ValueError(f"lptv.Model description: unknown field {unknown[0]!r} (fields: {', '.join(_FIELDS)})")
+        for key in ("w0", "a_real", "a_imag", "b_real", "b_imag", "version"):
+            if key not in d:
+                raise ValueError(f"lptv.Model description lacks the field {key!r}")
+        v = d["version"]
+        if isinstance(v, bool) or not isinstance(v, int) or v != FORMAT_VERSION:
+            raise ValueError(f"lptv.Model description: version must be {FORMAT_VERSION} (the only version this "
+                             f"lptv reads), got {v!r}")
+        w0 = _w0(d["w0"])
+        ts = _ts(d.get("ts"))
+
+        def coef(key):
+            try:
+                arr = np.array(d[key], dtype=float)
+            except (TypeError, ValueError):
+                raise ValueError(f"lptv.Model description: {key} must be a 2-D list of numbers, "
+                                 f"got {_short(d[key])}") from None
+            if arr.ndim != 2 or arr.size == 0:
+                raise ValueError(f"lptv.Model description: {key} must be a non-empty 2-D list of numbers, "
+                                 f"got shape {arr.shape}")
+            return arr
+
+        parts = {k: coef(k) for k in ("a_real", "a_imag", "b_real", "b_imag")}
+        for side in "ab":
+            re_, im = parts[f"{side}_real"], parts[f"{side}_imag"]
+            if re_.shape != im.shape:
+                raise ValueError(f"lptv.Model description: {side}_imag must have the shape of {side}_real "
+                                 f"{re_.shape}, got {im.shape}")
         try:
-            a = np.asarray(d["a_real"], float) + 1j * np.asarray(d["a_imag"], float)
-            b = np.asarray(d["b_real"], float) + 1j * np.asarray(d["b_imag"], float)
-            m = cls(a, b, w0=d["w0"], ts=d.get("ts"))
-        except KeyError as e:
-            raise ValueError(f"lptv.Model description lacks the field {e.args[0]!r}") from None
-        if d.get("covariance") is not None:
-            cov = np.asarray(d["covariance"], float)
-            names = tuple(str(n) for n in d.get("eta_names", ()))
+            m = cls(parts["a_real"] + 1j * parts["a_imag"], parts["b_real"] + 1j * parts["b_imag"], w0=w0, ts=ts)
+        except ValueError as e:
+            raise ValueError(f"lptv.Model description: {e}") from None
+        cov = d.get("covariance")
+        if cov is not None:
+            names = d.get("eta_names", ())
+            if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
+                raise ValueError(f"lptv.Model description: eta_names must be a list of parameter names, "
+                                 f"got {_short(names)}")
+            try:
+                cov = np.array(cov, dtype=float)
+            except (TypeError, ValueError):
+                raise ValueError(f"lptv.Model description: covariance must be a square list of numbers, "
+                                 f"got {_short(cov)}") from None
             if cov.shape != (len(names), len(names)):
                 raise ValueError(f"lptv.Model description: covariance of shape {cov.shape} does not match "
                                  f"its {len(names)} eta_names")
-            m.covariance, m.eta_names = cov, names
+            if not np.all(np.isfinite(cov)):
+                raise ValueError("lptv.Model description: covariance contains NaN or inf")
+            m.covariance, m.eta_names = cov, tuple(names)
         return m
 
     def save(self, path) -> None:
         """Write the model as JSON (readable by :meth:`Model.load`)."""
-        with open(os.fspath(path), "w") as f:
+        with open(as_path(path), "w") as f:
             json.dump(self.to_dict(), f, indent=1)
 
     @classmethod
     def load(cls, path) -> "Model":
-        """Read a model written by :meth:`Model.save`."""
-        with open(os.fspath(path)) as f:
-            try:
-                d = json.load(f)
-            except json.JSONDecodeError as e:
-                raise ValueError(f"{path}: not valid JSON ({e})") from None
-        return cls.from_dict(d)
+        """Read a model written by :meth:`Model.save`. A file that is not such a description (not
+        JSON, binary, another version, a field of the wrong type or shape) is a ValueError naming
+        the file and the problem; a missing file is FileNotFoundError."""
+        d = load_json(path)
+        try:
+            return cls.from_dict(d)
+        except ValueError as e:
+            raise ValueError(f"{os.fspath(path)}: {e}") from None
 
     def __eq__(self, other) -> bool:
         return (
@@ -308,3 +362,8 @@ class Model:
         dom = "continuous" if not self.discrete else f"discrete, ts={self.ts:g}"
         return (f"lptv.Model(na={self.na}, nb={self.nb}, ka={self.ka}, kb={self.kb}, "
                 f"w0={self.w0:g}, {dom})")
+
+
+def _short(x) -> str:
+    r = repr(x)
+    return r if len(r) <= 60 else r[:57] + "..."

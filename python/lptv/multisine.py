@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_real_1d, as_spectrum
+from ._validate import as_int, as_int_list, as_real_1d, as_seed, as_spectrum
 
 
 @dataclass(frozen=True)
@@ -32,12 +32,19 @@ class Multisine:
         return float(_core.crest_factor(self.signal))
 
     def periods(self, P: int) -> np.ndarray:
-        """P consecutive periods, shape (P, N)."""
-        return np.tile(self.signal, (int(P), 1))
+        """P >= 1 consecutive periods, shape (P, N)."""
+        P = as_int(P, "P", minimum=1, maximum=max(1, 2**31 // max(self.n_samples, 1)))
+        return np.tile(self.signal, (P, 1))
 
 
 def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
     """Random-phase multisine ``u(t) = sum_l A_l cos(l w0 t + phi_l)``, phi_l ~ U[0, 2 pi).
+
+    On line 0 (DC) and, for even N, the Nyquist line N/2 a real signal holds ``A cos(phi)`` only
+    (``cos(pi n)`` has no sine partner on the grid), so a random phase would realise a random
+    amplitude ``A |cos(phi)|``. There the phase is 0 or pi instead, drawn as the sign of the
+    cosine of the uniform phase: the line has the amplitude A with a random sign, and the other
+    lines' phases are those the same seed gave before.
 
     Parameters
     ----------
@@ -60,16 +67,28 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
     np.float64(0.5)
     """
     n_samples = as_int(n_samples, "n_samples", minimum=1)
-    ln = np.atleast_1d(np.asarray(lines))
+    if lines is None or isinstance(lines, (str, bytes)):
+        raise ValueError(f"lines must be integers, got {lines!r}")
+    ln = np.atleast_1d(np.asarray(lines, dtype=object if _has_big_int(lines) else None))
     if ln.size == 0:
         raise ValueError("lines must not be empty")
+    if ln.ndim != 1:
+        raise ValueError(f"lines must be 1-D, got shape {ln.shape}")
+    if ln.dtype == object:
+        try:
+            vals = as_int_list(ln, "lines", minimum=-np.inf, maximum=np.inf)
+        except ValueError:
+            raise ValueError("lines must be integers, got non-numeric values") from None
+        if min(vals) < 0 or max(vals) > n_samples // 2:
+            raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), got {min(vals)}..{max(vals)}")
+        ln = np.array(vals, dtype=np.int64)
     if not np.issubdtype(ln.dtype, np.integer):
         if not (np.issubdtype(ln.dtype, np.floating) and np.all(np.isfinite(ln))
                 and np.all(ln == np.round(ln))):
             raise ValueError(f"lines must be integers, got {ln.dtype} values")
-        ln = ln.astype(int)
-    if ln.ndim != 1:
-        raise ValueError(f"lines must be 1-D, got shape {ln.shape}")
+        if np.any(np.abs(ln.astype(np.float64)) > 2.0**62):
+            raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), got {ln.min():.0f}..{ln.max():.0f}")
+        ln = ln.astype(np.int64)
     if np.any(ln < 0) or np.any(ln > n_samples // 2):
         raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), "
                          f"got {ln.min()}..{ln.max()}")
@@ -80,8 +99,10 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
     if amp.shape != ln.shape:
         raise ValueError(f"amplitudes must be a scalar or have one entry per line ({ln.size}), "
                          f"got {amp.size}")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    rng = as_seed(seed)
     phases = rng.uniform(0.0, 2 * np.pi, ln.size)
+    real = (ln == 0) | ((n_samples % 2 == 0) & (ln == n_samples // 2))
+    phases[real] = np.where(np.cos(phases[real]) >= 0, 0.0, np.pi)
     X = np.asarray(_core.multisine_spectrum([int(x) for x in ln], np.ascontiguousarray(amp),
                                             phases, n_samples))
     x = np.asarray(_core.time_signal(X, n_samples))
@@ -125,3 +146,11 @@ def time_signal(X, n_samples: int) -> np.ndarray:
         Xa = Xa.copy()
         Xa[n_samples // 2] = Xa[n_samples // 2].real
     return np.asarray(_core.time_signal(Xa, n_samples))
+
+
+def _has_big_int(x) -> bool:
+    """Python ints beyond int64 (NumPy would raise OverflowError converting them)."""
+    try:
+        return any(isinstance(v, int) and not -2**63 <= v < 2**63 for v in np.ravel(np.asarray(x, dtype=object)))
+    except Exception:
+        return False

@@ -7,7 +7,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_str
+from ._validate import as_float, as_lines, as_int, as_str
 from .data import FrequencyData, frequency_data_of
 
 
@@ -87,6 +87,7 @@ class HtfEstimate:
 
     def significant(self, alpha: float = 1e-3) -> np.ndarray:
         """The branches that stand above the noise: p-value below ``alpha``."""
+        alpha = as_float(alpha, "alpha", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
         return self.k[self.p_value < alpha]
 
     def branch(self, k: int) -> np.ndarray:
@@ -173,10 +174,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
         if not lines:
             raise ValueError("u: no line stands above the input noise; pass excited= explicitly")
     else:
-        try:
-            lines = [as_int(v, "excited", minimum=1, maximum=data.max_line) for v in excited]
-        except TypeError:
-            raise ValueError(f"excited must be a sequence of integers, got {excited!r}") from None
+        lines = as_lines(excited, "excited", minimum=1, maximum=data.max_line)
     h = _core.htf_estimate(data._cpp, lines, branches)
     n = len(h.lines)
     stat = np.asarray(h.branch_statistic)

@@ -28,7 +28,7 @@ def _source(obj):
         names = tuple(obj.eta_names)
         eta = np.array([_value(obj, n) for n in names]) if names else np.zeros(0)
         return obj, names, eta, obj.covariance
-    raise ValueError(f"expected an IdentificationResult or an lptv.Model, got {type(obj).__name__}")
+    raise ValueError(f"obj must be an IdentificationResult or an lptv.Model, got {type(obj).__name__}")
 
 
 def _value(model, name):
@@ -48,9 +48,9 @@ def _parse(name):
 def _z(level):
     from scipy.stats import norm
 
-    level = float(level)
-    if not 0.0 < level < 1.0:
-        raise ValueError(f"level must be in (0, 1), got {level!r}")
+    from ._validate import as_float
+
+    level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
     return float(norm.ppf(0.5 + level / 2.0))
 
 
@@ -268,6 +268,7 @@ def freqresp_band(obj, w, *, level: float = 0.95, branch: int = 0):
     phase (first order, central differences over the parameters): ``(H, std_abs, std_phase_rad)``;
     the stds are None without a covariance."""
     model, names, eta, cov = _source(obj)
+    _z(level)
     H = model.freqresp(w, branch=branch)
     if cov is None or not names:
         return H, None, None
@@ -316,8 +317,18 @@ def compare(obj, u, y):
     from .fds import simulate
     from .multisine import spectrum, time_signal
 
+    from ._validate import _array, check_finite
+
     model = _source(obj)[0]
-    u, y = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(y, float))
+    sig = {}
+    for name, x in (("u", u), ("y", y)):
+        a = _array(x, name)
+        if np.iscomplexobj(a):
+            raise ValueError(f"{name} must be a real time signal, got complex values")
+        a = np.atleast_2d(a.astype(float))
+        check_finite(a, name)
+        sig[name] = a
+    u, y = sig["u"], sig["y"]
     if u.shape != y.shape or u.ndim != 2:
         raise ValueError(f"u and y must have the same shape (P, N) or (N,), got {u.shape} and {y.shape}")
     N = u.shape[1]

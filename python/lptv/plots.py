@@ -18,9 +18,31 @@ def _axes(ax, figsize=(6.4, 4.0)):
     return Figure(figsize=figsize, layout="constrained").subplots()
 
 
+def _series(x, name, n=None, ndim=1):
+    """A numeric array of the given dimension (and length n along its first axis) to plot; NaN
+    and inf are allowed (a pole at infinity, a line without data)."""
+    from ._validate import _array
+
+    a = _array(x, name)
+    if a.ndim != ndim:
+        raise ValueError(f"{name} must be {ndim}-D, got shape {a.shape}")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(f"{name} must have one value per line or time ({n}), got {a.shape[0]}")
+    return a
+
+
+def _options(w0=None, hz=False):
+    from ._validate import as_bool, as_float
+
+    as_bool(hz, "hz")
+    if w0 is not None and w0 != 0:
+        as_float(w0, "w0", minimum=0.0, open_min=True, what="a finite positive angular frequency (rad/s)")
+
+
 def _freq_axis(lines, w0, hz):
     """x values and label of a frequency axis: line * w0 in rad/s (or Hz), else the line number."""
-    lines = np.asarray(lines)
+    _options(w0, hz)
+    lines = _series(lines, "lines")
     if not w0:
         return lines, "line (multiple of the fundamental)"
     if hz:
@@ -46,8 +68,11 @@ def output_spectrum(lines, Y_fds, Y_time=None, *, w0=None, ax=None, labels=("FDS
     hz : bool
         With ``w0``: the frequency axis in Hz instead of rad/s.
     """
-    ax = _axes(ax)
     x, xlabel = _freq_axis(lines, w0, hz)
+    _series(Y_fds, "Y_fds", x.size)
+    if Y_time is not None:
+        _series(Y_time, "Y_time", x.size)
+    ax = _axes(ax)
     if Y_time is not None:
         ax.plot(x, _db(Y_time), "o", ms=4.5, mfc="none", mew=0.8, color="C1", label=labels[1])
     ax.plot(x, _db(Y_fds), ".", ms=3, color="C0", zorder=3, label=labels[0])
@@ -72,6 +97,15 @@ def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zero
     reads off as an angle); by default it is on unless the curves are far wider than tall (the
     paper's Fig. 3), and always on in the z-plane.
     """
+    from ._validate import as_bool
+
+    t = _series(t, "t")
+    for name, arr in (("poles_true", poles_true), ("zeros_true", zeros_true), ("poles_est", poles_est),
+                      ("zeros_est", zeros_est)):
+        if arr is not None:
+            _series(np.atleast_2d(arr) if np.ndim(arr) < 2 else arr, name, t.size, ndim=2)
+    discrete = as_bool(discrete, "discrete")
+    zoom_on_poles = as_bool(zoom_on_poles, "zoom_on_poles")
     ax = _axes(ax)
     style = {"true": dict(lw=2.0, alpha=0.5), "est": dict(lw=1.0, ls="--")}
     drawn = []
@@ -129,8 +163,10 @@ def frozen_poles_zeros(t, poles_true=None, zeros_true=None, poles_est=None, zero
 def prediction_error(lines, noise_std, error, *, w0=None, ax=None, mean_noise_std=None, hz=False):
     """Output-noise standard deviation against |true - predicted output| per line (paper Fig. 4);
     against frequency l * w0 in rad/s (or Hz with ``hz``) when ``w0`` is given."""
-    ax = _axes(ax)
     x, xlabel = _freq_axis(lines, w0, hz)
+    _series(noise_std, "noise_std", x.size)
+    _series(error, "error", x.size)
+    ax = _axes(ax)
     ax.plot(x, _db(noise_std), "-", color="C0", label="output noise std (one period)")
     if mean_noise_std is not None:
         ax.plot(x, _db(mean_noise_std), "-", color="C0", alpha=0.4, label="std of the mean of P periods")
@@ -147,8 +183,9 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
     """Normalised residue |e_l| / sqrt(var e_l) per line in dB with the 0 dB line (paper Fig. 6);
     against frequency l * w0 in rad/s (or Hz with ``hz``) when ``w0`` is given. ``excited``: the
     lines to mark (those the verdict judges), drawn on top in another colour."""
-    ax = _axes(ax)
     x, xlabel = _freq_axis(lines, w0, hz)
+    _series(r, "r", x.size)
+    ax = _axes(ax)
     if excited is None:
         ax.plot(x, _db(r), ".", ms=4, color="C0")
     else:
@@ -179,9 +216,11 @@ def coefficients(t, true=None, est=None, *, names=None, ax=None, ylabel="coeffic
     """
     from matplotlib.lines import Line2D
 
+    t = _series(t, "t")
+    drawn = [(_series(arr, lab if lab == "true" else "est", t.size, ndim=2), lab)
+             for arr, lab in ((true, "true"), (est, "estimated")) if arr is not None]
     ax = _axes(ax)
     styles = {"true": dict(ls="-", lw=3.0, alpha=0.35), "estimated": dict(ls="--", lw=1.2)}
-    drawn = [(np.asarray(arr), lab) for arr, lab in ((true, "true"), (est, "estimated")) if arr is not None]
     n = max((arr.shape[1] for arr, _ in drawn), default=0)
     label = [names[j] if names else f"c{j}" for j in range(n)]
     if len(drawn) == 1:  # one kind: plain lines, as the legend shows them
@@ -206,9 +245,11 @@ def model_fit(lines, Y, Y_model, noise_std=None, *, w0=None, ax=None, hz=False):
     """Measured output spectrum, the model's output, their difference and the noise level (dB),
     against frequency l * w0 in rad/s (or Hz with ``hz``) when ``w0`` is given. The model is drawn
     as open circles under the measured points, so the data stay visible."""
-    ax = _axes(ax)
     x, xlabel = _freq_axis(lines, w0, hz)
-    Y, Y_model = np.asarray(Y), np.asarray(Y_model)
+    Y, Y_model = _series(Y, "Y", x.size), _series(Y_model, "Y_model", x.size)
+    if noise_std is not None:
+        _series(noise_std, "noise_std", x.size)
+    ax = _axes(ax)
     if noise_std is not None:
         ax.plot(x, _db(noise_std), "-", color="0.55", lw=1.0, label="noise std of the mean output")
     ax.plot(x, _db(Y - Y_model), ".", ms=2.5, color="C3", alpha=0.7, label="difference |Y - Y_model|")
@@ -239,7 +280,16 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
         Frequency axis in Hz instead of rad/s.
     """
     from .fds import htf
+    from .model import Model
+    from .nonparametric import HtfEstimate
+    from ._validate import as_bool, as_int
 
+    if not isinstance(est, HtfEstimate):
+        raise ValueError(f"est must be an lptv.HtfEstimate, got {type(est).__name__}")
+    if model is not None and not isinstance(model, Model):
+        raise ValueError(f"model must be an lptv.Model or None, got {type(model).__name__}")
+    hz = as_bool(hz, "hz")
+    guard = as_int(guard, "guard")
     ax = _axes(ax)
     x = est.w / (2 * np.pi) if hz else est.w
     sig = set(est.significant().tolist())
@@ -287,9 +337,18 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
 
     Returns the figure (magnitude on top, phase below).
     """
-    from .parameters import freqresp_band
+    from .identify import IdentificationResult
+    from .parameters import _z, freqresp_band
     from scipy.stats import norm
+    from ._validate import as_bool, as_int
 
+    if not isinstance(res, IdentificationResult):
+        raise ValueError(f"res must be an lptv.IdentificationResult, got {type(res).__name__}")
+    if res.data is None:
+        raise ValueError("res must carry its data (res.data is None)")
+    hz = as_bool(hz, "hz")
+    _z(level)
+    n_points = as_int(n_points, "n_points", minimum=2, maximum=100_000)
     if fig is None:
         from matplotlib.figure import Figure
 
@@ -359,6 +418,9 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
 
 def compare(cmp, *, ax=None, unit: str = ""):
     """Measured against simulated output over one period (a :func:`lptv.compare` result)."""
+    if not isinstance(cmp, dict) or not {"t", "y", "y_model", "fit"} <= set(cmp):
+        raise ValueError(f"cmp must be the dict lptv.compare returns (keys t, y, y_model, fit), got "
+                         f"{type(cmp).__name__}")
     ax = _axes(ax)
     ax.plot(cmp["t"], cmp["y"], "-", color="C0", lw=1.0, label="measured (mean of the periods)")
     ax.plot(cmp["t"], cmp["y_model"], "--", color="C1", lw=1.2, label=f"model, fit {cmp['fit']:.1f} %")

@@ -7,7 +7,7 @@ from typing import Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_spectrum
+from ._validate import _array, as_int, as_spectrum
 from .fds import simulate
 from .identify import _counts, _known_list, _rows
 from .model import Model
@@ -41,7 +41,10 @@ class CramerRaoBound:
 
 
 def _per_line(v, n, name):
-    arr = np.asarray(v, dtype=complex if name == "cov_yu" else float)
+    arr = _array(v, name)
+    if name != "cov_yu" and np.iscomplexobj(arr):
+        raise ValueError(f"{name} must be real (a variance), got complex values")
+    arr = arr.astype(complex if name == "cov_yu" else float)
     if arr.ndim == 0:
         arr = np.full(n, arr)
     if arr.shape != (n,):

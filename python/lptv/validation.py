@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_real_1d
+from ._validate import as_int, as_lines, as_real_1d
 from .model import Model
 
 
@@ -19,9 +19,15 @@ def normalized_residue(model: Model, data, lines, *, _par=None, _theta=None):
     -------
     e, var_e, r : ndarrays over the rows
     """
+    from .data import FrequencyData
+
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+    if not isinstance(data, FrequencyData):
+        raise ValueError(f"data must be an lptv.FrequencyData, got {type(data).__name__}")
+    rows = as_lines(lines, "lines")
     par = _par if _par is not None else _structure_of(model)
     theta = _theta if _theta is not None else par.theta_from_model(model._cpp)
-    rows = [int(x) for x in lines]
     par.check_rows(rows, data.max_line)
     e = np.asarray(_core.residue(data._cpp, par, rows, theta))
     var_e = np.asarray(_core.residue_variance(data._cpp, par, rows, theta))
@@ -51,6 +57,8 @@ def expected_fraction_above_0db(n_rows: int, n_free: int, periods: int):
     periods = as_int(periods, "periods")
     if periods == 1:
         raise ValueError("periods must be 0 (known variances) or >= 2, got 1")
+    if n_free >= 2 * n_rows:
+        raise ValueError(f"n_free must be below the 2 n_rows = {2 * n_rows} real equations of the rows, got {n_free}")
     p, band = _core.expected_fraction_above_0db(n_rows, n_free, periods)
     return p, tuple(band)
 

@@ -112,7 +112,7 @@ def test_simulate_warn_unstable_false_and_type_check():
         warnings.simplefilter("error")
         Y = lptv.simulate(m, _line1(), warn_unstable=False)
     assert Y[1] == pytest.approx(0.5 / (1j - 1.0), rel=1e-14)   # the exact periodic solution
-    with pytest.raises(TypeError, match="warn_unstable"):
+    with pytest.raises(ValueError, match="warn_unstable"):
         lptv.simulate(m, _line1(), warn_unstable="no")
 
 

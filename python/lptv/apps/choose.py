@@ -27,9 +27,16 @@ import numpy as np
 
 from lptv import read_measurements, select
 from lptv.apps.fileid import parse_lines, positive
+from lptv.apps.options import bounded_range, in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import write_json
 from lptv.measurements import FileError
+
+
+GRID_MAX = 10_000
+"""The most values one grid option may hold (every combination is a fit)."""
+OPTION_NAMES = {"na": "--na", "nb": "--nb", "k": "--k", "refine": "--refine", "lines": "--lines",
+                "criterion": "--criterion", "w0": "--w0", "ts": "--ts", "workers": "--workers"}
 
 
 def parse_grid(text, opt):
@@ -39,7 +46,7 @@ def parse_grid(text, opt):
         m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", tok)
         if not m or (m.group(2) and int(m.group(2)) < int(m.group(1))):
             raise FileError(f"{opt}: '{tok.strip()}' is not a non-negative integer or a range like 1-3")
-        out.extend(range(int(m.group(1)), int(m.group(2) or m.group(1)) + 1))
+        out.extend(bounded_range(int(m.group(1)), int(m.group(2) or m.group(1)), opt, tok.strip(), GRID_MAX))
     if len(set(out)) != len(out):
         raise FileError(f"{opt}: a value is given twice in '{text}'")
     return sorted(out)
@@ -78,7 +85,8 @@ def add_parser(sub):
 
 
 def _error(problem) -> int:
-    print(f"lptv select: error: {' '.join(str(problem).split()) or type(problem).__name__}", file=sys.stderr)
+    msg = in_option_terms(' '.join(str(problem).split()) or type(problem).__name__, OPTION_NAMES)
+    print(f"lptv select: error: {msg}", file=sys.stderr)
     return 2
 
 
@@ -105,6 +113,11 @@ def run(args) -> int:
         lines = parse_lines(args.lines) if args.lines is not None else None
         if args.refine < 0:
             raise FileError(f"--refine must be >= 0, got {args.refine}")
+        integer(args.refine, "--refine")
+        try:
+            output_folder(args.out)
+        except OSError as e:
+            raise FileError(f"{e.filename or args.out}: {e.strerror or e}") from None
         executor, workers = executor_of(args)
         meas = read_measurements(src, args.periods)
         w0 = _w0(args, meas)

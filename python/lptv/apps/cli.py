@@ -68,7 +68,9 @@ def _version() -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(
+    from lptv.apps.options import Parser
+
+    parser = Parser(
         prog="lptv", description="lptv: identification of linear periodically time-varying systems")
     parser.add_argument("--version", action="version", version=f"lptv {_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -94,6 +96,12 @@ def main(argv=None) -> int:
             raise
         print(_plots_missing(args.command) or f"lptv {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except (MemoryError, OverflowError) as e:
+        # sizes the options allow but the machine cannot hold: one line, not a traceback
+        what = "out of memory" if isinstance(e, MemoryError) else "a number too large"
+        print(f"lptv {args.command}: error: {what}" + (f": {e}" if str(e) else "")
+              + " (reduce the sizes given in the options)", file=sys.stderr)
+        return 2
 
 
 def _run(parser, args) -> int:
@@ -102,10 +110,21 @@ def _run(parser, args) -> int:
             parser.error("--monte-carlo must be >= 0")
         if args.periods < 2:
             parser.error("--periods must be >= 2")
+        from lptv.apps.options import INT_MAX, output_folder
+
+        for opt, v in (("--monte-carlo", args.monte_carlo), ("--periods", args.periods)):
+            if v > INT_MAX:
+                parser.error(f"{opt} must be at most {INT_MAX}, got {v}")
+        if args.seed < 0:
+            parser.error(f"--seed must be >= 0, got {args.seed}")
         msg = _plots_missing("demo")
         if msg:  # the demo's product is its report: say so before computing anything
             print(msg, file=sys.stderr)
             return 2
+        try:
+            output_folder(args.out)
+        except OSError as e:
+            parser.error(f"--out {e.filename or args.out}: {e.strerror or e}")
         if args.case == "lecture":
             from lptv.apps import lecture
 

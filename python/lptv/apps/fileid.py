@@ -36,13 +36,14 @@ import numpy as np
 
 from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_zeros, identify, lti_table,
                   parameter_table, plots, read_measurements, simulate)
+from lptv.apps.options import MAX_EXPANDED, bounded_range, in_option_terms, integer, output_folder
 from lptv.apps.report import Report, write_json
 from lptv import METHODS
 from lptv.measurements import FileError
 
 # ------------------------------------------------------------------------------ options
 
-def parse_lines(text: str):
+def parse_lines(text: str, opt: str = "--lines"):
     """'1-243', '1-100,120-150' or '10,20,30' -> the line numbers, in the order given;
     'excited' -> 'excited' (the lines the input excites, +-K for an LPTV model)."""
     if text.strip().lower() == "excited":
@@ -51,15 +52,15 @@ def parse_lines(text: str):
     for tok in text.split(","):
         m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", tok)
         if not m:
-            raise FileError(f"--lines: '{tok.strip()}' is not a line number or a range like 1-243")
+            raise FileError(f"{opt}: '{tok.strip()}' is not a line number or a range like 1-243")
         lo = int(m.group(1))
         hi = int(m.group(2)) if m.group(2) else lo
         if hi < lo:
-            raise FileError(f"--lines: '{tok.strip()}' is an empty range")
-        out.extend(range(lo, hi + 1))
+            raise FileError(f"{opt}: '{tok.strip()}' is an empty range")
+        out.extend(bounded_range(lo, hi, opt, tok.strip(), MAX_EXPANDED - len(out)))
     values, counts = np.unique(out, return_counts=True)
     if np.any(counts > 1):
-        raise FileError(f"--lines: line {values[counts > 1][0]} is given twice")
+        raise FileError(f"{opt}: line {values[counts > 1][0]} is given twice")
     return np.array(out)
 
 
@@ -193,8 +194,14 @@ def _one_line(problem) -> str:
     return " ".join(str(problem).split()) or type(problem).__name__
 
 
+OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_iter": "--max-iter",
+                "tol": "--tol", "lines": "--lines", "known": "--known", "method": "--method", "w0": "--w0",
+                "ts": "--ts", "periods": "--periods"}
+"""The arguments of lptv.identify and the options that set them, for the messages."""
+
+
 def _fail(name, problem) -> int:
-    print(f"lptv identify: error: {name}: {_one_line(problem)}", file=sys.stderr)
+    print(f"lptv identify: error: {name}: {in_option_terms(_one_line(problem), OPTION_NAMES)}", file=sys.stderr)
     return 2
 
 
@@ -211,10 +218,16 @@ def run(args) -> int:
         return manyid.run(args)
     src = args.files[0]
     try:
+        output_folder(args.out)
+    except OSError as e:
+        return _fail(e.filename or args.out, e.strerror or e)
+    try:
         lines = parse_lines(args.lines) if args.lines is not None else None
         ka, kb, known = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb"), parse_known(args.known)
         if args.max_iter < 0:
             raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
+        for opt in ("na", "nb", "max_iter"):
+            integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         positive(args.tol, "--tol")
         period = None
         if args.fs is not None or args.dt is not None:

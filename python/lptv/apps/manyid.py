@@ -20,13 +20,15 @@ from pathlib import Path
 import numpy as np
 
 from lptv import identify_many
-from lptv.apps.fileid import parse_counts, parse_known, parse_lines, positive
+from lptv.apps.fileid import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive
+from lptv.apps.options import in_option_terms, integer, output_folder
 from lptv.apps.report import write_json
 from lptv.measurements import FileError
 
 
 def _error(problem) -> int:
-    print(f"lptv identify: error: {' '.join(str(problem).split())}", file=sys.stderr)
+    print(f"lptv identify: error: {in_option_terms(' '.join(str(problem).split()), OPTION_NAMES)}",
+          file=sys.stderr)
     return 2
 
 
@@ -65,7 +67,10 @@ def run(args) -> int:
         positive(args.ts, "--ts")
         if args.periods is not None and args.periods < 1:
             raise FileError(f"--periods must be a positive integer, got {args.periods}")
+        for opt in ("na", "nb", "max_iter"):
+            integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         executor, workers = executor_of(args)
+        output_folder(args.out)
         result = identify_many(args.files, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts,
                                lines=lines, method=args.method, known=known, tol=args.tol,
                                max_iter=args.max_iter, periods=args.periods, executor=executor,

@@ -24,6 +24,7 @@ import numpy as np
 
 from lptv import METHODS, Model, montecarlo, multisine
 from lptv.apps.fileid import parse_lines
+from lptv.apps.options import in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import Report, write_json
 from lptv.examples import (PAPER_ID_LINES, PAPER_NOISE, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB,
@@ -74,8 +75,15 @@ def add_parser(sub):
     return p
 
 
+OPTION_NAMES = {"runs": "--runs", "periods": "--periods", "snr_in_db": "--snr-in",
+                "snr_out_db": "--snr-out", "pole_in": "--pole-in", "pole_out": "--pole-out",
+                "correlation": "--correlation", "seed": "--seed", "chunk_size": "--chunk-size",
+                "lines": "--lines", "n_samples": "--samples", "workers": "--workers"}
+
+
 def _error(problem) -> int:
-    print(f"lptv montecarlo: error: {' '.join(str(problem).split())}", file=sys.stderr)
+    print(f"lptv montecarlo: error: {in_option_terms(' '.join(str(problem).split()), OPTION_NAMES)}",
+          file=sys.stderr)
     return 2
 
 
@@ -94,7 +102,9 @@ def _design(args):
         raise FileError(f"--model {args.model}: {e}") from None
     if args.excited is None:
         raise FileError("--model needs --excited, the lines of the multisine (e.g. 1-60)")
-    excited = parse_lines(args.excited)
+    excited = parse_lines(args.excited, "--excited")
+    if isinstance(excited, str):
+        raise FileError("--excited must list the multisine's lines, e.g. 1-60")
     N = args.samples or (model.samples_per_period if model.discrete else 2048)
     if model.discrete and N != model.samples_per_period:
         raise FileError(f"--samples {N}: the discrete model has {model.samples_per_period} samples per period")
@@ -111,6 +121,12 @@ def run(args) -> int:
             raise FileError(f"--runs must be >= 1, got {args.runs}")
         if args.periods < 2:
             raise FileError(f"--periods must be >= 2, got {args.periods}")
+        integer(args.runs, "--runs", minimum=1)
+        integer(args.periods, "--periods", minimum=2)
+        integer(args.samples, "--samples", minimum=1)
+        integer(args.seed, "--seed", maximum=2**63)
+        integer(args.multisine_seed, "--multisine-seed", maximum=2**63)
+        output_folder(args.out)
         model, ms, lines, what = _design(args)
         executor, workers = executor_of(args)
         print(f"lptv montecarlo: {what}; {args.runs} runs x {args.method}, P = {args.periods}, "

@@ -11,7 +11,7 @@ from typing import Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .._validate import as_int, as_positive_float
+from .._validate import as_float, as_int, as_path, as_positive_float
 from ..identify import METHODS, _counts, _known_list, _rows, identify
 from ..measurements import Measurements, read_measurements
 from ..model import Model
@@ -113,7 +113,7 @@ class BatchResult:
 
     def save(self, path) -> Path:
         """Write the rows as CSV (plain Python) or Parquet (by the suffix; needs pyarrow)."""
-        path = Path(os.fspath(path))
+        path = Path(as_path(path))
         if path.suffix.lower() == ".parquet":
             require("pyarrow", "writing Parquet")
             self.table().to_parquet(path, index=False)
@@ -141,6 +141,9 @@ def _names(records, names):
         if names is not None:
             raise ValueError("names must be omitted when records is a dict (its keys are the names)")
         return [str(k) for k in records], list(records.values())
+    if isinstance(records, (str, bytes, os.PathLike)):
+        raise ValueError(f"records must be a sequence of files or (u, y) records, got the single path "
+                         f"{os.fsdecode(records)!r}: pass [path]")
     try:
         records = list(records)
     except TypeError:
@@ -212,8 +215,7 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     _known_list(known, ka_l, kb_l)
     if lines is not None:
         lines = _rows(lines)
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be > 0, got {tol!r}")
+    tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter")
     w0 = None if w0 is None else as_positive_float(w0, "w0")
     ts = None if ts is None else as_positive_float(ts, "ts")

@@ -14,7 +14,7 @@ from typing import Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from .._validate import as_int, as_real_1d
+from .._validate import as_float, as_int, as_real_1d
 from ..data import FrequencyData
 from ..examples import noise_variances, noisy_periods
 from ..fds import simulate
@@ -217,9 +217,10 @@ def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, p
                  pole_out=_in_range(pole_out, "pole_out", -1, 1, False),
                  correlation=_in_range(correlation, "correlation", -1, 1, True))
     level = _in_range(level, "level", 0, 1, False)
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be > 0, got {tol!r}")
+    tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=0)
+    if isinstance(seed, (bool, float, complex, str, bytes)):
+        raise ValueError(f"seed must be an int, a sequence of ints or a SeedSequence, got {seed!r}")
     if not isinstance(seed, np.random.SeedSequence):
         try:
             seed = np.random.SeedSequence(seed)

@@ -124,7 +124,9 @@ class MonteCarloTables:
         """
         if format not in _FORMATS:
             raise ValueError(f"format must be one of {_FORMATS}, got {format!r}")
-        out = Path(os.fspath(directory))
+        from .._validate import as_path
+
+        out = Path(as_path(directory, "directory"))
         out.mkdir(parents=True, exist_ok=True)
         paths = {"estimates": out / f"estimates.{format}", "fits": out / f"fits.{format}",
                  "summary": out / "summary.csv", "overview": out / "overview.csv"}

@@ -1,0 +1,84 @@
+"""What the commands share about their options.
+
+Every bad option value ends in one line on stderr and exit status 2, never a usage block or a
+traceback: argparse's own errors go through :class:`Parser`; a message of the library that names
+a Python argument (``max_iter must be ...``) is put in the option's terms (``--max-iter must be
+...``) by :func:`in_option_terms`; ranges of lines or grid values are bounded before they are
+expanded; an output folder given with ``--out`` is checked before any work, so that a folder
+that cannot be written is reported at once.
+"""
+from __future__ import annotations
+
+import argparse
+import errno
+import os
+import re
+import tempfile
+from pathlib import Path
+
+from lptv.measurements import FileError
+
+INT_MAX = 2**31 - 1
+"""The largest integer the core takes (a C int)."""
+MAX_EXPANDED = 2**26
+"""The most values a range option (``--lines 1-N``) may expand to: the largest grid of the core."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``prog: error: message`` on stderr, exit status 2 (the usage
+    block stays in ``--help``)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {' '.join(str(message).split())}\n")
+
+
+def integer(value, opt, minimum=0, maximum=INT_MAX):
+    """An integer option's value within [minimum, maximum], or a FileError naming the option."""
+    if value is None:
+        return None
+    if value < minimum:
+        raise FileError(f"{opt} must be >= {minimum}, got {value}")
+    if value > maximum:
+        raise FileError(f"{opt} must be at most {maximum}, got {value}")
+    return value
+
+
+def bounded_range(lo: int, hi: int, opt: str, token: str, limit: int = MAX_EXPANDED):
+    """range(lo, hi + 1) after checking that hi fits the core's int and that the range is not
+    larger than ``limit`` values (a typo like 1-99999999999 would otherwise fill the memory)."""
+    if hi > INT_MAX:
+        raise FileError(f"{opt}: '{token}' goes beyond {INT_MAX}, the largest value the core takes")
+    if hi - lo + 1 > limit:
+        raise FileError(f"{opt}: '{token}' holds {hi - lo + 1} values; at most {limit} are accepted")
+    return range(lo, hi + 1)
+
+
+def output_folder(path):
+    """Check, before any work, that the folder given with ``--out`` can be made and written, without
+    leaving anything behind: OSError (its filename the folder) when a file stands there, or the
+    nearest existing folder above it refuses a new entry."""
+    if path is None:
+        return None
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise FileExistsError(errno.EEXIST, "File exists", str(path))
+    parent = p
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", str(path))
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".lptv-probe-", dir=parent))
+    except OSError as e:
+        raise OSError(e.errno, e.strerror, str(path)) from None
+    return path
+
+
+def in_option_terms(message: str, names: dict) -> str:
+    """A library message that starts with a Python argument's name (``max_iter must be``,
+    ``lines: row 0 ...``), restated with the option (``--max-iter must be``)."""
+    for name, opt in names.items():
+        new = re.sub(rf"^{re.escape(name)}(?=[\s:])", opt, message)
+        if new != message:
+            return new
+    return message
