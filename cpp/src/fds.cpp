@@ -9,6 +9,7 @@
 
 #include "band_kernel.hpp"
 #include "band_row.hpp"
+#include "fds_fold.hpp"
 #include "lptv/errors.hpp"
 
 namespace lptv {
@@ -121,7 +122,7 @@ Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& 
 
 namespace {
 
-constexpr double kGoldenAngle = 2.399963229728653;
+constexpr double kGoldenAngle = detail::kCheckPhaseStep;
 
 // The conditioning check's right-hand side (see Fds::condition): row i's magnitude of terms,
 // sum over its entries of sum_n |a_{n,k}| |s_j|^n, times the unit phase exp(j g i) of the
@@ -239,6 +240,13 @@ class ModelRows {
   cd phase_{1.0, 0.0}, step_;
 };
 
+[[noreturn]] void zero_pivot(int column, const std::function<std::string(int)>& label) {
+  std::ostringstream msg;
+  msg << "A is singular at " << label(column)
+      << " (a zero pivot: the system has a pole on that line, or a_na(t) vanishes)";
+  throw NumericalError(msg.str());
+}
+
 // The small band kernel on the model's grid: factorises A with the right-hand sides of
 // ModelRows eliminated on the way, back-substitutes them, and returns the solutions of the U
 // columns (n x U.cols()) and the check's max |x_i| and where it is.
@@ -261,10 +269,7 @@ FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXc
       detail::back_substitute<decltype(kt)::value>(f, nz, z.data());
     });
   } catch (const detail::ZeroPivot& e) {
-    std::ostringstream msg;
-    msg << "A is singular at " << label(e.column)
-        << " (a zero pivot: the system has a pole on that line, or a_na(t) vanishes)";
-    throw NumericalError(msg.str());
+    zero_pivot(e.column, label);
   }
   FusedSolve out;
   const int nu = nz - 1;
@@ -330,6 +335,20 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
   }
   if (out.solver == Solver::Band && !out.grid.circular && use_small_band(m)) {
     const auto label = line_label(out.grid);
+    if (detail::can_fold(m, out.grid, U_full)) {
+      // A real input (what simulate passes): half the grid (fds_fold.hpp).
+      detail::FoldedSolution r;
+      try {
+        r = detail::solve_folded(m, out.grid, U_full);
+      } catch (const detail::ZeroPivot& e) {
+        zero_pivot(e.column, label);
+      }
+      if (!r.Y.allFinite()) throw NumericalError("band solve produced NaN or inf");
+      check_condition(r.condition, r.where, label);
+      out.Y = std::move(r.Y);
+      out.condition = r.condition;
+      return out;
+    }
     detail::BandFactors f;
     FusedSolve r = fused_band_solve(m, out.grid, &U_full, f, false, label);
     check_condition(r.condition, r.where, label);
