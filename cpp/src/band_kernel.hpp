@@ -44,9 +44,16 @@ inline kcd cmsub(kcd a, kcd l, kcd u) {
   return {a.real() - (l.real() * u.real() - l.imag() * u.imag()),
           a.imag() - (l.real() * u.imag() + l.imag() * u.real())};
 }
-// 1 / p by Smith's method (no overflow of |p|^2).
+// 1 / p: conj(p) / |p|^2, one division on the elimination's critical path (each step's
+// multipliers wait for it); Smith's method (two divisions) where |p|^2 could overflow or lose
+// bits to underflow.
 inline kcd crecip(kcd p) {
   const double a = p.real(), b = p.imag();
+  const double m = std::max(std::abs(a), std::abs(b));
+  if (m > 1e-150 && m < 1e150) {
+    const double id = 1.0 / (a * a + b * b);
+    return {a * id, -b * id};
+  }
   if (std::abs(a) >= std::abs(b)) {
     const double r = b / a, id = 1.0 / (a + b * r);
     return {id, -r * id};
@@ -212,8 +219,10 @@ void back_substitute(const BandFactors& f, int nz, kcd* z) {
     const kcd* Uk = &f.U[static_cast<size_t>(k) * W];
     kcd* zk = z + static_cast<size_t>(k) * nz;
     for (int c = 0; c < nz; ++c) {
+      // The farthest term first: z_{k+1}, which the step before has just written, comes last,
+      // so one product and one subtraction separate the steps instead of 2K of them.
       kcd s = zk[c];
-      for (int j = 1; j < W; ++j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
+      for (int j = W - 1; j >= 1; --j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
       zk[c] = cmul(s, Uk[0]);
     }
   }

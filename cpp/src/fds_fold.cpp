@@ -15,23 +15,26 @@ namespace detail {
 namespace {
 
 // Rows L, L-1, ..., 0 of A in the unknowns Y_L, Y_L-1, ..., Y_0 (row r and column c of the
-// reversed matrix are lines L - r and L - c), each built from the band-row kernel with the
-// same band_entry calls on the same powers as build_A and ModelRows (fds.cpp): the same bits.
-// Right-hand sides of a row: (B U)_l for each column of U, summed in the full grid's order,
-// then the check's entry m_l exp(j g l).
+// reversed matrix are lines L - r and L - c), each built from the band-row kernel's
+// band_entry_ct: the same numbers as build_A's band_entry.
+// Right-hand sides of a row: (B U)_l for each column of U, summed in the full grid's order
+// (U_{-l} = conj(U_l)), then the check's entry m_l exp(j g l).
 class FoldedRows {
  public:
-  FoldedRows(const Model& m, const Grid& g, const Eigen::MatrixXcd& U)
-      : m_(m), U_(U), L_(g.L), K_(m.ka()), Kb_(m.kb()), Km_(std::max(K_, Kb_)), na_(m.na()),
+  FoldedRows(const Model& m, const Grid& g, const HalfInput& U)
+      : m_(m), U_(U), R_(static_cast<int>(std::min<Eigen::Index>(U.rows(), g.L + 1))), L_(g.L), K_(m.ka()), Kb_(m.kb()), Km_(std::max(K_, Kb_)), na_(m.na()),
         nb_(m.nb()), P_(std::max(na_, nb_) + 1), nrhs_(static_cast<int>(U.cols())),
-        absa_(m.a().cwiseAbs()), next_(g.L) {
+        absa_(m.a().cwiseAbs()), aj_(m.a().rows(), m.a().cols()), bj_(m.b().rows(), m.b().cols()),
+        next_(g.L) {
+    for (Eigen::Index k = 0; k < aj_.cols(); ++k) times_j_powers(m.a().col(k).data(), na_, aj_.col(k).data());
+    for (Eigen::Index k = 0; k < bj_.cols(); ++k) times_j_powers(m.b().col(k).data(), nb_, bj_.col(k).data());
     int R = 1;
     while (R < 2 * Km_ + 1) R *= 2;
     mask_ = R - 1;
-    pw_.resize(static_cast<size_t>(R) * P_);
+    t_.resize(static_cast<size_t>(R) * P_);
     wn_.resize(static_cast<size_t>(R) * (na_ + 1));
-    nonzero_.resize(g.N);
-    for (int i = 0; i < g.N; ++i) nonzero_[i] = !U.row(i).isZero(0.0);
+    nonzero_.assign(g.L + 1, 0);  // by |line|
+    for (int i = 0; i < R_; ++i) nonzero_[i] = !U.row(i).isZero(0.0);
     step_ = std::polar(1.0, -kCheckPhaseStep);  // from line l to line l - 1
   }
   int columns() const { return nrhs_ + 1; }
@@ -40,7 +43,7 @@ class FoldedRows {
   void row(int r, int base, cd* out) {
     const int l = L_ - r;
     ensure(l - Km_);
-    const cd* a = m_.a().data();
+    const cd* a = aj_.data();
     for (int j = 0; j <= 2 * K_; ++j) {
       const int i = L_ - base - j;
       out[j] = (i < 0 || i > L_ || std::abs(l - i) > K_) ? cd(0.0, 0.0) : entry(a, l, i);
@@ -48,23 +51,25 @@ class FoldedRows {
   }
   // A(l, i) for |l - i| <= K, any line i of the grid (negative lines too).
   cd entry(const cd* a, int l, int i) const {
-    return band_entry(a + static_cast<size_t>(K_ + l - i) * (na_ + 1), pw(i), na_);
+    return band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (na_ + 1), t(i), na_);
   }
-  const cd* a() const { return m_.a().data(); }
+  const cd* a() const { return aj_.data(); }
 
   void rhs(int r, cd* z) {
     const int l = L_ - r;
     ensure(l - Km_);
-    const cd* b = m_.b().data();
+    const cd* b = bj_.data();
     const int lo = std::max(-L_, l - Kb_), hi = std::min(L_, l + Kb_);
     for (int q = 0; q < nrhs_; ++q) {
-      const cd* u = U_.data() + static_cast<size_t>(q) * U_.rows() + L_;  // u[i]: line i
+      const cd* u = U_.col(q).data();  // line i >= 0; conj(u[-i]) for i < 0
       double re = 0.0, im = 0.0;
       for (int c = lo; c <= hi; ++c) {
-        if (!nonzero_[L_ + c]) continue;
-        const cd v = band_entry(b + static_cast<size_t>(Kb_ + l - c) * (nb_ + 1), pw(c), nb_);
-        re += v.real() * u[c].real() - v.imag() * u[c].imag();
-        im += v.real() * u[c].imag() + v.imag() * u[c].real();
+        const int a = c < 0 ? -c : c;
+        if (!nonzero_[a]) continue;
+        const cd uc = c < 0 ? std::conj(u[a]) : u[a];
+        const cd v = band_entry_ct(b + static_cast<size_t>(Kb_ + l - c) * (nb_ + 1), t(c), nb_);
+        re += v.real() * uc.real() - v.imag() * uc.imag();
+        im += v.real() * uc.imag() + v.imag() * uc.real();
       }
       z[q] = cd(re, im);
     }
@@ -80,24 +85,25 @@ class FoldedRows {
   }
 
  private:
-  const cd* pw(int c) const { return &pw_[static_cast<size_t>(c & mask_) * P_]; }
+  const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P_]; }
   const double* wn(int c) const { return &wn_[static_cast<size_t>(c & mask_) * (na_ + 1)]; }
   // Powers of the lines down to c (rows arrive by decreasing line).
   void ensure(int c) {
     for (; next_ >= c; --next_) {
-      const cd s = line_variable(m_.w0(), m_.ts(), next_);
-      line_powers(s, P_ - 1, &pw_[static_cast<size_t>(next_ & mask_) * P_]);
-      const double as = s.real() == 0.0 ? std::abs(s.imag()) : std::sqrt(std::norm(s));
-      line_powers(as, na_, &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)]);
+      // s = j w, w = w0 l as line_variable forms it; |s|^n = |w^n| (the same products).
+      double* t = &t_[static_cast<size_t>(next_ & mask_) * P_];
+      real_powers(m_.w0() * next_, P_ - 1, t);
+      double* wn = &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)];
+      for (int n = 0; n <= na_; ++n) wn[n] = std::abs(t[n]);
     }
   }
   const Model& m_;
-  const Eigen::MatrixXcd& U_;
-  int L_, K_, Kb_, Km_, na_, nb_, P_, nrhs_, mask_ = 0;
+  const HalfInput& U_;
+  int R_, L_, K_, Kb_, Km_, na_, nb_, P_, nrhs_, mask_ = 0;
   Eigen::MatrixXd absa_;
+  Eigen::MatrixXcd aj_, bj_;  // the coefficients times j^n (times_j_powers)
   int next_;  // the highest line whose powers are not yet computed
-  std::vector<cd> pw_;
-  std::vector<double> wn_;
+  std::vector<double> t_, wn_;
   std::vector<char> nonzero_;
   cd phase_{1.0, 0.0}, step_;
   bool first_ = true;
@@ -153,10 +159,14 @@ class CornerSystem {
 
 }  // namespace
 
-bool can_fold(const Model& m, const Grid& g, const Eigen::MatrixXcd& U_full) {
-  const int K = m.ka(), L = g.L;
-  if (g.circular || m.discrete() || K < 1 || K > SmallBandLU::kMaxK || L < 2 * K + 1) return false;
-  if (U_full.rows() != g.N) return false;
+bool can_fold(const Model& m, const Grid& g) {
+  const int K = m.ka();
+  return !g.circular && !m.discrete() && K >= 1 && K <= SmallBandLU::kMaxK && g.L >= 2 * K + 1;
+}
+
+bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full) {
+  const int L = g.L;
+  if (g.circular || U_full.rows() != g.N) return false;
   for (Eigen::Index q = 0; q < U_full.cols(); ++q) {
     const cd* u = U_full.col(q).data() + L;
     if (u[0].imag() != 0.0) return false;
@@ -166,7 +176,7 @@ bool can_fold(const Model& m, const Grid& g, const Eigen::MatrixXcd& U_full) {
   return true;
 }
 
-FoldedSolution solve_folded(const Model& m, const Grid& g, const Eigen::MatrixXcd& U) {
+FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
   const int L = g.L, K = m.ka(), W = 2 * K + 1;
   FoldedRows src(m, g, U);
   const int nz = src.columns(), nu = nz - 1;
@@ -213,15 +223,12 @@ FoldedSolution solve_folded(const Model& m, const Grid& g, const Eigen::MatrixXc
   dispatch_band(K, [&](auto kt) { back_substitute<decltype(kt)::value>(f, nz, z.data()); });
 
   FoldedSolution out;
-  out.Y.resize(g.N, nu);
+  out.Y.resize(L + 1, nu);
   double best = -1.0;
   int at = 0;
   for (int l = 0; l <= L; ++l) {
     const cd* zl = &z[static_cast<size_t>(L - l) * nz];
-    for (int q = 0; q < nu; ++q) {
-      out.Y(L + l, q) = zl[q];
-      out.Y(L - l, q) = std::conj(zl[q]);
-    }
+    for (int q = 0; q < nu; ++q) out.Y(l, q) = zl[q];
     const double a = std::norm(zl[nu]);
     if (a > best || !(a == a)) best = a, at = l;
   }

@@ -27,20 +27,25 @@ namespace detail {
 // The unit phase step of the conditioning check's right-hand side (the golden angle).
 constexpr double kCheckPhaseStep = 2.399963229728653;
 
-// Whether solve_folded applies: a continuous-time grid of at least 2K + 1 lines each side,
-// 1 <= K (= Ka) <= SmallBandLU::kMaxK, and U_full conjugate-symmetric about line 0 (exactly,
-// as simulate builds it from one-sided spectra).
-bool can_fold(const Model& m, const Grid& g, const Eigen::MatrixXcd& U_full);
+// Whether solve_folded applies to the model on the grid: continuous time, at least 2K + 1
+// lines each side, 1 <= K (= Ka) <= SmallBandLU::kMaxK.
+bool can_fold(const Model& m, const Grid& g);
+// Whether the full-grid input is conjugate-symmetric about line 0, exactly (U_0 real), as
+// simulate builds it from one-sided spectra.
+bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full);
+
+// One-sided input: row l is line l (U_0 real), lines beyond the last row are zero.
+using HalfInput = Eigen::Ref<const Eigen::MatrixXcd>;
 
 struct FoldedSolution {
-  Eigen::MatrixXcd Y;      // the full grid (g.N rows)
+  Eigen::MatrixXcd Y;      // lines 0..L (the negative lines are their conjugates)
   double condition = 0.0;  // max |x| of the check's solution
-  int where = 0;           // its grid index (the line >= 0)
+  int where = 0;           // its grid index (a line >= 0)
 };
 
-// Y = A^-1 B U_full on the grid with the check. Throws ZeroPivot (band_kernel.hpp) with the
-// grid index of the first exactly zero pivot.
-FoldedSolution solve_folded(const Model& m, const Grid& g, const Eigen::MatrixXcd& U_full);
+// Y = A^-1 B U on the grid with the check. Throws ZeroPivot (band_kernel.hpp) with the grid
+// index of the first exactly zero pivot.
+FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U);
 
 }  // namespace detail
 }  // namespace lptv

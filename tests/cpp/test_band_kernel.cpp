@@ -251,6 +251,25 @@ TEST_CASE("the half-grid route for a real input equals LAPACK's band LU on the f
   REQUIRE(pivoting_models > 0);  // the premise: the band steps pivot for some deep models
 }
 
+TEST_CASE("the one-pass route builds build_A's entries, bit for bit", "[band][fds]") {
+  // The route builds A's rows with band_entry_ct (half the products of band_entry, the same
+  // numbers); with the same entries and right-hand sides the kernel's fused elimination does
+  // the operations of SmallBandLU's factorisation and two substitutions in the same order, so
+  // the solutions agree in every bit. A general (not conjugate-symmetric) input takes the
+  // full-grid route.
+  for (int K : {1, 3, 7, 9}) {
+    for (double depth : {0.3, 3.0}) {
+      const lptv::Model m = random_model(K, 5 * K + 1, depth);
+      const int L = 40;
+      const lptv::Grid g = lptv::make_grid(m, L);
+      const Eigen::MatrixXcd U = random_rhs(g.N, 2, K + 11);
+      const lptv::SmallBandLU lu(g.N, K, band_storage(lptv::build_A(m, g), K), col_label);
+      CAPTURE(K, depth);
+      REQUIRE(lptv::solve_grid(m, L, U, lptv::Solver::Band).Y == lu.solve(lptv::apply_B(m, g, U)));
+    }
+  }
+}
+
 TEST_CASE("the half-grid route names the line of an exactly singular A", "[fds]") {
   // s^2 + 4 with zero harmonics (Ka = 1): a pole on line 2 / w0. With w0 = 1 the zero pivot is
   // in the band steps (line 2 >= 2K), with w0 = 2 in the corner (line 1 < 2K).
