@@ -6,6 +6,7 @@
 #include <functional>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "band_kernel.hpp"
 #include "band_row.hpp"
@@ -186,13 +187,23 @@ class ModelRows {
   void row(int r, int base, cd* out) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
     const int lo = std::max(0, r - K_ - base), hi = std::min({2 * K_, r + K_ - base, g_.N - 1 - base});
-    const cd* a = aj_.data();
     for (int j = 0; j < lo; ++j) out[j] = cd(0.0, 0.0);
-    for (int j = lo; j <= hi; ++j) {
-      const int c = base + j;
-      out[j] = detail::band_entry_ct(a + static_cast<size_t>(K_ + r - c) * (na_ + 1), t(c), na_);
+    // The order as a constant for the common ones, so that the sums unroll (the same sums).
+    switch (na_) {
+      case 1: entries(r, base, lo, hi, std::integral_constant<int, 1>(), out); break;
+      case 2: entries(r, base, lo, hi, std::integral_constant<int, 2>(), out); break;
+      case 3: entries(r, base, lo, hi, std::integral_constant<int, 3>(), out); break;
+      default: entries(r, base, lo, hi, na_, out); break;
     }
     for (int j = hi + 1; j <= 2 * K_; ++j) out[j] = cd(0.0, 0.0);
+  }
+  template <class Order>
+  void entries(int r, int base, int lo, int hi, Order na, cd* out) const {
+    const cd* a = aj_.data();
+    for (int j = lo; j <= hi; ++j) {
+      const int c = base + j;
+      out[j] = detail::band_entry_ct(a + static_cast<size_t>(K_ + r - c) * (na + 1), t(c), na);
+    }
   }
 
   void rhs(int r, cd* z) {

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "band_kernel.hpp"
@@ -43,10 +44,22 @@ class FoldedRows {
   void row(int r, int base, cd* out) {
     const int l = L_ - r;
     ensure(l - Km_);
+    // The order as a constant for the common ones, so that the sums unroll (the same sums).
+    switch (na_) {
+      case 1: return row_of(l, base, std::integral_constant<int, 1>(), out);
+      case 2: return row_of(l, base, std::integral_constant<int, 2>(), out);
+      case 3: return row_of(l, base, std::integral_constant<int, 3>(), out);
+      default: return row_of(l, base, na_, out);
+    }
+  }
+  template <class Order>
+  void row_of(int l, int base, Order na, cd* out) const {
     const cd* a = aj_.data();
     for (int j = 0; j <= 2 * K_; ++j) {
       const int i = L_ - base - j;
-      out[j] = (i < 0 || i > L_ || std::abs(l - i) > K_) ? cd(0.0, 0.0) : entry(a, l, i);
+      out[j] = (i < 0 || i > L_ || std::abs(l - i) > K_)
+                   ? cd(0.0, 0.0)
+                   : band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (na + 1), t(i), na);
     }
   }
   // A(l, i) for |l - i| <= K, any line i of the grid (negative lines too).
@@ -73,10 +86,13 @@ class FoldedRows {
       }
       z[q] = cd(re, im);
     }
-    const double* absa = absa_.data();
-    double mag = 0;
-    for (int c = std::max(-L_, l - K_); c <= std::min(L_, l + K_); ++c)
-      mag += band_entry(absa + static_cast<size_t>(K_ + l - c) * (na_ + 1), wn(c), na_);
+    double mag;
+    switch (na_) {
+      case 1: mag = magnitude(l, std::integral_constant<int, 1>()); break;
+      case 2: mag = magnitude(l, std::integral_constant<int, 2>()); break;
+      case 3: mag = magnitude(l, std::integral_constant<int, 3>()); break;
+      default: mag = magnitude(l, na_); break;
+    }
     // exp(j g l) by a recurrence down the lines, re-anchored every 256 lines and at line 0
     // (exactly 1 there: the real part of row 0 is all the corner takes).
     phase_ = (first_ || (l & 255) == 255 || l == 0) ? std::polar(1.0, kCheckPhaseStep * l) : cmul(phase_, step_);
@@ -85,6 +101,15 @@ class FoldedRows {
   }
 
  private:
+  // The check's row magnitude: the sum over row l's entries of sum_n |a_{n,k}| |s_c|^n.
+  template <class Order>
+  double magnitude(int l, Order na) const {
+    const double* absa = absa_.data();
+    double mag = 0;
+    for (int c = std::max(-L_, l - K_); c <= std::min(L_, l + K_); ++c)
+      mag += band_entry(absa + static_cast<size_t>(K_ + l - c) * (na + 1), wn(c), static_cast<int>(na));
+    return mag;
+  }
   const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P_]; }
   const double* wn(int c) const { return &wn_[static_cast<size_t>(c & mask_) * (na_ + 1)]; }
   // Powers of the lines down to c (rows arrive by decreasing line).
