@@ -23,8 +23,9 @@ namespace {
 class FoldedRows {
  public:
   FoldedRows(const Model& m, const Grid& g, const HalfInput& U)
-      : m_(m), U_(U), R_(static_cast<int>(std::min<Eigen::Index>(U.rows(), g.L + 1))), L_(g.L), K_(m.ka()), Kb_(m.kb()), Km_(std::max(K_, Kb_)), na_(m.na()),
-        nb_(m.nb()), P_(std::max(na_, nb_) + 1), nrhs_(static_cast<int>(U.cols())),
+      : m_(m), U_(U), R_(static_cast<int>(std::min<Eigen::Index>(U.rows(), g.L + 1))), L_(g.L),
+        K_(m.ka()), Kb_(m.kb()), Km_(std::max(K_, Kb_)), na_(m.na()), nb_(m.nb()),
+        P_(std::max(na_, nb_) + 1), nrhs_(static_cast<int>(U.cols())),
         absa_(m.a().cwiseAbs()), aj_(m.a().rows(), m.a().cols()), bj_(m.b().rows(), m.b().cols()),
         next_(g.L) {
     for (Eigen::Index k = 0; k < aj_.cols(); ++k) times_j_powers(m.a().col(k).data(), na_, aj_.col(k).data());
