@@ -231,10 +231,56 @@ Solved solve_gtls(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
 
 }  // namespace
 
-EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
-                        const EstimateOptions& opt) {
-  d.validate();
-  check_rows(p, rows, d.max_line());
+namespace {
+
+// The experiments of one fit, by reference: data and rows of each.
+struct Experiments {
+  std::vector<const FrequencyData*> d;
+  std::vector<const std::vector<int>*> rows;
+  size_t size() const { return d.size(); }
+};
+
+// R of the stacked real Jacobian: one experiment's own R, or the R factors of several
+// experiments (each n x n) stacked and reduced by one more small QR.
+Eigen::MatrixXd stacked_r_factor(const Experiments& x, const Parametrisation& p,
+                                 const std::vector<Eigen::VectorXd>& w) {
+  if (x.size() == 1) return weighted_r_factor(*x.d[0], p, *x.rows[0], w[0]);
+  const int n = p.n_xi();
+  Eigen::MatrixXd M(static_cast<Eigen::Index>(x.size()) * n, n);
+  for (size_t e = 0; e < x.size(); ++e)
+    M.middleRows(static_cast<Eigen::Index>(e) * n, n) = weighted_r_factor(*x.d[e], p, *x.rows[e], w[e]);
+  Eigen::Ref<Eigen::MatrixXd> Mr = M;
+  Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(Mr);
+  return M.topRows(n).triangularView<Eigen::Upper>();
+}
+
+// CJ_W summed over the experiments (independent noise: the expectations add).
+Eigen::MatrixXd summed_column_covariance(const Experiments& x, const Parametrisation& p,
+                                         const std::vector<Eigen::VectorXd>& w) {
+  Eigen::MatrixXd CJ = real_column_covariance(*x.d[0], p, *x.rows[0], w[0]);
+  for (size_t e = 1; e < x.size(); ++e) CJ += real_column_covariance(*x.d[e], p, *x.rows[e], w[e]);
+  return CJ;
+}
+
+EstimateResult estimate_experiments(const Experiments& x, const Parametrisation& p, const EstimateOptions& opt) {
+  const size_t E = x.size();
+  if (E == 0) throw std::invalid_argument("experiments: the list is empty");
+  size_t n_rows = 0;
+  for (size_t e = 0; e < E; ++e) {
+    x.d[e]->validate();
+    if (E == 1) {
+      check_rows(p, *x.rows[e], x.d[e]->max_line());
+    } else {
+      check_row_lines(p.structure(), *x.rows[e], x.d[e]->max_line());
+    }
+    n_rows += x.rows[e]->size();
+  }
+  if (E > 1 && 2 * static_cast<long long>(n_rows) <= p.n_xi() - 1) {
+    throw std::invalid_argument("the orders and harmonic counts leave " + std::to_string(p.n_xi() - 1) +
+                                " free parameters for " + std::to_string(2 * n_rows) +
+                                " real equations over all experiments (" + std::to_string(n_rows) +
+                                " lines): use more lines or fewer harmonics / lower orders");
+  }
   if (!(opt.tol > 0)) throw std::invalid_argument("tol must be > 0");
   if (opt.max_iter < 0) throw std::invalid_argument("max_iter must be >= 0");
   // The dense work here is on n_xi x n_xi matrices (tens of columns), where a multithreaded
@@ -242,14 +288,14 @@ EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const 
   // made single WGTLS fits of the paper's example take 300-600 ms instead of 10 ms.
   const detail::SingleThreadedBlas guard(true);
   EstimateResult res;
-  const Eigen::VectorXd none;
   auto finish = [&](const Solved& s) {
     res.theta = p.theta_from_xi(s.x);
     res.eta = p.eta_from_xi(s.x);
     res.singular_values = s.values;
     res.cost = s.cost;
   };
-  const Eigen::MatrixXd R = weighted_r_factor(d, p, rows, none);
+  std::vector<Eigen::VectorXd> w(E);
+  const Eigen::MatrixXd R = stacked_r_factor(x, p, w);
   if (opt.method == Method::LS) {
     finish(solve_ls(R, p.norm_index()));
     return res;
@@ -258,7 +304,8 @@ EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const 
     finish(solve_tls(R));
     return res;
   }
-  const Eigen::MatrixXd CJ = real_column_covariance(d, p, rows, Eigen::VectorXd::Ones(rows.size()));
+  for (size_t e = 0; e < E; ++e) w[e] = Eigen::VectorXd::Ones(x.rows[e]->size());
+  const Eigen::MatrixXd CJ = summed_column_covariance(x, p, w);
   if (CJ.cwiseAbs().maxCoeff() == 0.0) {
     // No noise anywhere: the noise-weighted problems have no weight to apply and
     // reduce to TLS, which is exact on noise-free data.
@@ -270,19 +317,25 @@ EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const 
   if (opt.method == Method::GTLS) return res;
 
   res.converged = false;
+  std::vector<Eigen::VectorXd> v(E);
   for (int it = 1; it <= opt.max_iter; ++it) {
-    Eigen::VectorXd v = residue_variance(d, p, rows, res.theta);
-    const double vmax = v.maxCoeff();
-    if (!(vmax > 0) || !v.allFinite()) {
+    double vmax = -std::numeric_limits<double>::infinity();
+    bool finite = true;
+    for (size_t e = 0; e < E; ++e) {
+      v[e] = residue_variance(*x.d[e], p, *x.rows[e], res.theta);
+      vmax = std::max(vmax, v[e].maxCoeff());
+      finite = finite && v[e].allFinite();
+    }
+    if (!(vmax > 0) || !finite) {
       throw NumericalError("WGTLS: the residue variance is not positive at iteration " +
                            std::to_string(it));
     }
     // Rows whose residue carries (numerically) no noise get the largest finite weight
     // rather than an infinite one.
     const double floor = vmax * 1e-14;
-    const Eigen::VectorXd w = v.cwiseMax(floor).cwiseInverse();
-    const Eigen::MatrixXd Rw = weighted_r_factor(d, p, rows, w);
-    const Eigen::MatrixXd CJw = real_column_covariance(d, p, rows, w);
+    for (size_t e = 0; e < E; ++e) w[e] = v[e].cwiseMax(floor).cwiseInverse();
+    const Eigen::MatrixXd Rw = stacked_r_factor(x, p, w);
+    const Eigen::MatrixXd CJw = summed_column_covariance(x, p, w);
     const Eigen::VectorXcd prev = res.theta;
     finish(solve_gtls(Rw, CJw));
     res.iterations = it;
@@ -296,18 +349,46 @@ EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const 
   if (opt.method == Method::SML) {
     // The exact likelihood from the WGTLS estimate: WGTLS is consistent, so the start is
     // close and the Gauss-Newton steps of the refinement are short.
-    const ExactLikelihood lik(d, p, rows);
-    const ExactFit fit = minimise_exact_cost(lik, p, res.theta, opt.tol, opt.max_iter);
-    const double scale = 1.0 / (2.0 * static_cast<double>(rows.size()));
+    ExactFit fit;
+    if (E == 1) {
+      const ExactLikelihood lik(*x.d[0], p, *x.rows[0]);
+      fit = minimise_exact_cost(lik, p, res.theta, opt.tol, opt.max_iter);
+    } else {
+      std::vector<ExactLikelihood> liks;
+      for (size_t e = 0; e < E; ++e) liks.emplace_back(*x.d[e], p, *x.rows[e], ExactLikelihood::PartOfSeveral{});
+      fit = minimise_exact_cost(liks, p, res.theta, opt.tol, opt.max_iter);
+    }
+    const double scale = 1.0 / (2.0 * static_cast<double>(n_rows));
     res.theta = fit.theta;
     res.eta = p.eta_from_xi(fit.xi);
     res.iterations = fit.iterations;
     res.converged = fit.converged;
     res.cost = fit.cost * scale;
     res.cost_history.clear();
-    for (double v : fit.cost_history) res.cost_history.push_back(v * scale);
+    for (double c : fit.cost_history) res.cost_history.push_back(c * scale);
   }
   return res;
+}
+
+}  // namespace
+
+EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                        const EstimateOptions& opt) {
+  return estimate_experiments(Experiments{{&d}, {&rows}}, p, opt);
+}
+
+EstimateResult estimate(const std::vector<FrequencyData>& experiments, const Parametrisation& p,
+                        const std::vector<std::vector<int>>& rows, const EstimateOptions& opt) {
+  if (rows.size() != experiments.size()) {
+    throw std::invalid_argument("rows must give one list of rows per experiment (" +
+                                std::to_string(experiments.size()) + "), got " + std::to_string(rows.size()));
+  }
+  Experiments x;
+  for (size_t e = 0; e < experiments.size(); ++e) {
+    x.d.push_back(&experiments[e]);
+    x.rows.push_back(&rows[e]);
+  }
+  return estimate_experiments(x, p, opt);
 }
 
 }  // namespace lptv

@@ -337,6 +337,7 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
       const FusedSolve r = fused_band_solve(m, grid_, nullptr, *f, true, label);
       small_ = std::make_unique<SmallBandLU>(std::move(f));
       condition_ = r.condition;
+      condition_line_ = grid_.line_of(r.where);
       check_condition(condition_, r.where, label);
       return;
     }
@@ -351,6 +352,7 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   const Eigen::VectorXcd x = solve_A(check_rhs(m, grid_));
   Eigen::Index where = 0;
   condition_ = x.cwiseAbs().maxCoeff(&where);
+  condition_line_ = grid_.line_of(static_cast<int>(where));
   check_condition(condition_, static_cast<int>(where), label);
 }
 
@@ -372,6 +374,7 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
       out.Y.middleRows(L, L + 1) = r.Y;
       out.Y.topRows(L) = r.Y.bottomRows(L).colwise().reverse().conjugate();
       out.condition = r.condition;
+      out.condition_line = out.grid.line_of(r.where);  // a line >= 0 (|x| is symmetric)
       return out;
     }
     detail::BandFactors f;
@@ -379,11 +382,13 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
     check_condition(r.condition, r.where, label);
     out.Y = std::move(r.Y);
     out.condition = r.condition;
+    out.condition_line = out.grid.line_of(r.where);
     return out;
   }
   const Fds fds(m, L, solver);
   out.Y = fds.solve_full(U_full);
   out.condition = fds.condition();
+  out.condition_line = fds.condition_line();
   out.solver = fds.solver();
   return out;
 }
@@ -464,6 +469,26 @@ Eigen::MatrixXcd to_onesided(const Grid& g, const Eigen::MatrixXcd& Y, int lines
   return out;
 }
 
+// An LTI model's lines do not couple: the condition that matters for the output is that of
+// the lines with input, sum_n |a_n| |s_l|^n / |a(s_l)| (A's diagonal), the largest of them.
+void lti_condition_on_input_lines(const Model& m, const Eigen::MatrixXcd& U, SimulateResult& res) {
+  const int na = m.na();
+  std::vector<cd> pw(na + 1);
+  std::vector<double> wn(na + 1);
+  const Eigen::VectorXd absa = m.a().col(0).cwiseAbs();
+  res.condition = 0.0;
+  res.condition_line = 0;
+  for (Eigen::Index l = 0; l < U.rows(); ++l) {
+    if (U.row(l).isZero(0.0)) continue;
+    const cd s = detail::line_variable(m.w0(), m.ts(), static_cast<int>(l));
+    detail::line_powers(s, na, pw.data());
+    detail::line_powers(std::abs(s), na, wn.data());
+    const double c = detail::band_entry(absa.data(), wn.data(), na) /
+                     std::abs(detail::band_entry(m.a().col(0).data(), pw.data(), na));
+    if (c > res.condition) res.condition = c, res.condition_line = static_cast<int>(l);
+  }
+}
+
 // The highest line with a nonzero input (0 for an all-zero input).
 int last_nonzero_line(const Eigen::MatrixXcd& U) {
   for (Eigen::Index l = U.rows() - 1; l > 0; --l) {
@@ -537,6 +562,9 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     const GridSolution s = solve_grid(m, 0, to_full(g, U), opt.solver);
     res.Y = to_onesided(g, s.Y, lines_out);
     res.solver = s.solver;
+    res.condition = s.condition;
+    res.condition_line = std::min(s.condition_line, g.N - s.condition_line);
+    if (m.kmax() == 0) lti_condition_on_input_lines(m, U, res);
     return res;
   }
 
@@ -570,6 +598,8 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
       double edge = 0;
       for (int l = std::max(0, g.L - K + 1); l <= g.L; ++l) edge = std::max(edge, s.Y.row(l).cwiseAbs().maxCoeff());
       const double cond = std::max(1.0, s.condition);
+      res.condition = s.condition;
+      res.condition_line = g.line_of(s.where);
       Eigen::MatrixXcd out = Eigen::MatrixXcd::Zero(lines_out + 1, s.Y.cols());
       const int top = std::min(lines_out, g.L);
       out.topRows(top + 1) = s.Y.topRows(top + 1);
@@ -584,11 +614,14 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
       edge = std::max(edge, full.row(g.index_of(l)).cwiseAbs().maxCoeff());
     }
     const double cond = std::max(1.0, s.condition);
+    res.condition = s.condition;
+    res.condition_line = std::abs(s.condition_line);
     return Run{to_onesided(g, full, lines_out), 10.0 * cond * edge / peak, edge / peak, cond};
   };
   if (m.kmax() == 0) {
     // LTI: A is diagonal, lines do not couple, no truncation error.
     res.Y = run(band, 0).Y;
+    lti_condition_on_input_lines(m, U, res);
     return res;
   }
   if (opt.guard >= 0) {

@@ -75,6 +75,18 @@ ExactLikelihood::ExactLikelihood(const FrequencyData& d, const Parametrisation& 
     : d_(d), p_(p) {
   d_.validate();
   check_rows(p_, rows, d_.max_line());
+  init(rows);
+}
+
+ExactLikelihood::ExactLikelihood(const FrequencyData& d, const Parametrisation& p, std::vector<int> rows,
+                                 PartOfSeveral)
+    : d_(d), p_(p) {
+  d_.validate();
+  check_row_lines(p_.structure(), rows, d_.max_line());
+  init(rows);
+}
+
+void ExactLikelihood::init(const std::vector<int>& rows) {
   order_.resize(rows.size());
   std::iota(order_.begin(), order_.end(), 0);
   std::sort(order_.begin(), order_.end(), [&](int a, int b) { return rows[a] < rows[b]; });
@@ -282,6 +294,18 @@ Eigen::MatrixXd ExactLikelihood::fisher_information(const Eigen::VectorXcd& thet
 
 Eigen::MatrixXd ExactLikelihood::sandwich_covariance(const Eigen::VectorXcd& theta,
                                                      const Eigen::VectorXd& weights) const {
+  const SandwichTerms t = sandwich_terms(theta, weights);
+  return sandwich_from_terms(t.bread, t.meat);
+}
+
+Eigen::MatrixXd sandwich_from_terms(const Eigen::MatrixXd& bread, const Eigen::MatrixXd& meat) {
+  const Eigen::MatrixXd Hinv = symmetric_inverse(bread, "the weighted information matrix");
+  const Eigen::MatrixXd cov = Hinv * meat * Hinv;
+  return 0.5 * (cov + cov.transpose());
+}
+
+ExactLikelihood::SandwichTerms ExactLikelihood::sandwich_terms(const Eigen::VectorXcd& theta,
+                                                               const Eigen::VectorXd& weights) const {
   const int R = static_cast<int>(sorted_.size());
   if (weights.size() != R) throw std::invalid_argument("weights must have one entry per row");
   const Factor f = factor(theta);
@@ -294,24 +318,29 @@ Eigen::MatrixXd ExactLikelihood::sandwich_covariance(const Eigen::VectorXcd& the
     const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd_);
     for (Eigen::Index i = j; i <= last; ++i) LtWJ.row(j) += f.Lb(i - j, j) * J.row(i);
   }
-  const Eigen::MatrixXd meat = LtWJ.transpose() * LtWJ;
+  SandwichTerms t;
+  t.meat = LtWJ.transpose() * LtWJ;
   // H = J^T W J = (W J)^T J with the unweighted J: divide the weights back out.
   Eigen::MatrixXd J1 = J;
   for (int r = 0; r < R; ++r) J1.middleRows(2 * r, 2) /= weights[order_[r]];
-  const Eigen::MatrixXd Hinv = symmetric_inverse(J.transpose() * J1, "the weighted information matrix");
-  const Eigen::MatrixXd cov = Hinv * meat * Hinv;
-  return 0.5 * (cov + cov.transpose());
+  t.bread = J.transpose() * J1;
+  return t;
 }
 
-ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
-                             const Eigen::VectorXcd& theta0, double tol, int max_iter) {
+namespace {
+
+// Levenberg-Marquardt on V; `evaluate(theta)` gives the cost, the whitened residue and the
+// whitened Jacobian (of one experiment, or of several stacked).
+template <class Evaluate>
+ExactFit minimise(const Evaluate& evaluate, const Parametrisation& p, const Eigen::VectorXcd& theta0,
+                  double tol, int max_iter) {
   const std::vector<int> free = p.free_indices();
   const int nf = static_cast<int>(free.size());
   ExactFit fit;
   fit.xi = p.xi_from_theta(theta0);
   fit.theta = p.theta_from_xi(fit.xi);
   fit.xi = p.xi_from_theta(fit.theta);  // normalised
-  ExactLikelihood::Evaluation ev = lik.evaluate(fit.theta);
+  ExactLikelihood::Evaluation ev = evaluate(fit.theta);
   auto half_gradient = [&](const ExactLikelihood::Evaluation& e, Eigen::MatrixXd& J) {
     J = free_columns(e.jacobian, free);
     return Eigen::VectorXd(J.transpose() * e.whitened);
@@ -335,7 +364,7 @@ ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& 
       for (int c = 0; c < nf; ++c) xi_t[free[c]] += step[c];
       try {
         theta_t = p.theta_from_xi(xi_t);
-        ev_t = lik.evaluate(theta_t);
+        ev_t = evaluate(theta_t);
       } catch (const NumericalError&) {  // a step into a region where S is singular
         lambda *= 10;
         continue;
@@ -372,6 +401,41 @@ ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& 
   return fit;
 }
 
+}  // namespace
+
+ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
+                             const Eigen::VectorXcd& theta0, double tol, int max_iter) {
+  return minimise([&](const Eigen::VectorXcd& theta) { return lik.evaluate(theta); }, p, theta0, tol,
+                  max_iter);
+}
+
+ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
+                             const Eigen::VectorXcd& theta0, double tol, int max_iter) {
+  if (liks.empty()) throw std::invalid_argument("experiments: the list is empty");
+  if (liks.size() == 1) return minimise_exact_cost(liks[0], p, theta0, tol, max_iter);
+  // S block diagonal over the experiments: the whitened residues and Jacobians stack.
+  auto evaluate = [&](const Eigen::VectorXcd& theta) {
+    std::vector<ExactLikelihood::Evaluation> parts;
+    Eigen::Index rows = 0;
+    for (const ExactLikelihood& lik : liks) {
+      parts.push_back(lik.evaluate(theta));
+      rows += parts.back().whitened.size();
+    }
+    ExactLikelihood::Evaluation ev;
+    ev.whitened.resize(rows);
+    ev.jacobian.resize(rows, parts[0].jacobian.cols());
+    Eigen::Index at = 0;
+    for (const auto& e : parts) {
+      ev.cost += e.cost;
+      ev.whitened.segment(at, e.whitened.size()) = e.whitened;
+      ev.jacobian.middleRows(at, e.jacobian.rows()) = e.jacobian;
+      at += e.whitened.size();
+    }
+    return ev;
+  };
+  return minimise(evaluate, p, theta0, tol, max_iter);
+}
+
 Eigen::MatrixXd ExactLikelihood::residue_covariance(const Eigen::VectorXcd& theta) const {
   const Factor f = factor(theta);
   const Eigen::Index n = f.Lb.cols();
@@ -397,6 +461,29 @@ Eigen::MatrixXd cramer_rao_bound(const FrequencyData& noiseless, const Parametri
                                  const std::vector<int>& rows, const Eigen::VectorXcd& theta) {
   const ExactLikelihood lik(noiseless, p, rows);
   return eta_covariance(p, symmetric_inverse(lik.fisher_information(theta), "the Fisher information"));
+}
+
+Eigen::MatrixXd cramer_rao_bound(const std::vector<FrequencyData>& noiseless, const Parametrisation& p,
+                                 const std::vector<std::vector<int>>& rows, const Eigen::VectorXcd& theta) {
+  if (noiseless.empty()) throw std::invalid_argument("noiseless: the list of experiments is empty");
+  if (rows.size() != noiseless.size()) {
+    throw std::invalid_argument("rows must give one list of rows per experiment (" +
+                                std::to_string(noiseless.size()) + "), got " + std::to_string(rows.size()));
+  }
+  long long total = 0;
+  for (const auto& r : rows) total += static_cast<long long>(r.size());
+  if (2 * total <= p.n_xi() - 1) {
+    throw std::invalid_argument("the orders and harmonic counts leave " + std::to_string(p.n_xi() - 1) +
+                                " free parameters for " + std::to_string(2 * total) +
+                                " real equations over all experiments");
+  }
+  Eigen::MatrixXd F;
+  for (size_t e = 0; e < noiseless.size(); ++e) {
+    const ExactLikelihood lik(noiseless[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
+    const Eigen::MatrixXd Fe = lik.fisher_information(theta);
+    if (e == 0) F = Fe; else F += Fe;
+  }
+  return eta_covariance(p, symmetric_inverse(F, "the Fisher information"));
 }
 
 }  // namespace lptv

@@ -188,9 +188,13 @@ Eigen::VectorXd Parametrisation::eta_from_xi(const Eigen::VectorXd& xi) const {
   if (xi.size() != n_xi()) throw std::invalid_argument("xi has the wrong size");
   const double s = xi[norm_index_];
   if (!(std::abs(s) > 1e-300) || !std::isfinite(s)) {
-    throw NumericalError("normalisation failed: the estimate has a zero " +
-                                    std::string(has_known_ ? "weight on the known coefficients"
-                                                           : "a_{na,0}"));
+    throw NumericalError(
+        has_known_ ? "normalisation failed: the estimate gives the known coefficients zero weight, so "
+                     "they cannot set its scale (the data are explained without them: check the known "
+                     "values and their orders)"
+                   : "normalisation failed: the estimate's a_na has mean a_{na,0} = 0, so it cannot be "
+                     "scaled to 1 (the data point to a lower order, or a_na(t) averaging zero: lower na, "
+                     "or fix a nonzero coefficient with known)");
   }
   Eigen::VectorXd x = xi / s;
   if (has_known_) return x.head(n_eta());

@@ -1,3 +1,4 @@
+#include "lptv/diagnostics.hpp"
 #include "lptv/estimators.hpp"
 #include "pybind11.hpp"
 
@@ -33,6 +34,8 @@ void bind_estimators(py::module_& m) {
       .def_readonly("model", &lptv::Identification::model)
       .def_property_readonly("method", [](const lptv::Identification& r) { return lptv::method_name(r.method); })
       .def_readonly("rows", &lptv::Identification::rows)
+      .def_readonly("experiment", &lptv::Identification::experiment)
+      .def_readonly("n_experiments", &lptv::Identification::n_experiments)
       .def_readonly("theta", &lptv::Identification::theta)
       .def_readonly("eta", &lptv::Identification::eta)
       .def_readonly("eta_names", &lptv::Identification::eta_names)
@@ -72,4 +75,41 @@ void bind_estimators(py::module_& m) {
     return lptv::identify(d, s, opt);
   }, "data"_a, "structure"_a, "method"_a = "wgtls", "tol"_a = 1e-10, "max_iter"_a = 50,
         "rows"_a = std::vector<int>(), "covariance"_a = true);
+
+  m.def("identify_experiments", [](const std::vector<lptv::FrequencyData>& experiments, const lptv::Structure& s,
+                                   const std::string& method, double tol, int max_iter,
+                                   std::vector<std::vector<int>> rows, bool covariance) {
+    lptv::IdentifyOptions opt;
+    opt.method = lptv::method_from_string(method);
+    opt.tol = tol;
+    opt.max_iter = max_iter;
+    opt.experiment_rows = std::move(rows);
+    opt.covariance = covariance;
+    py::gil_scoped_release release;  // the whole identification is C++
+    return lptv::identify(experiments, s, opt);
+  }, "experiments"_a, "structure"_a, "method"_a = "wgtls", "tol"_a = 1e-10, "max_iter"_a = 50,
+        "rows"_a = std::vector<std::vector<int>>(), "covariance"_a = true,
+        R"doc(Several experiments of one system fitted into one model (lptv::identify on a list).
+
+rows: one list of rows per experiment (an empty list: that experiment's default rows), or
+empty for every experiment's default.)doc");
+
+  py::class_<lptv::ChannelPower>(m, "ChannelPower", "Signal of one channel on a set of lines (lptv::channel_power).")
+      .def_readonly("lines", &lptv::ChannelPower::lines)
+      .def_readonly("above", &lptv::ChannelPower::above)
+      .def_readonly("power", &lptv::ChannelPower::power)
+      .def_readonly("noise", &lptv::ChannelPower::noise)
+      .def_readonly("limit", &lptv::ChannelPower::limit)
+      .def_readonly("clear", &lptv::ChannelPower::clear)
+      .def_readonly("present", &lptv::ChannelPower::present);
+  py::class_<lptv::DataDiagnosis>(m, "DataDiagnosis", "What the data can say before estimating (lptv::diagnose_data).")
+      .def_readonly("region", &lptv::DataDiagnosis::region)
+      .def_readonly("input", &lptv::DataDiagnosis::input)
+      .def_readonly("output", &lptv::DataDiagnosis::output)
+      .def_readonly("excited", &lptv::DataDiagnosis::excited)
+      .def_readonly("informative_rows", &lptv::DataDiagnosis::informative_rows)
+      .def_readonly("warnings", &lptv::DataDiagnosis::warnings);
+  m.def("diagnose_data", &lptv::diagnose_data, "data"_a, "structure"_a, "rows"_a, "check_row_count"_a = true,
+        "The data diagnostics lptv::identify runs first: raises ValueError naming the argument and the "
+        "cause for degenerate data (METHOD.md section 15).");
 }

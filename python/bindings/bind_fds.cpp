@@ -23,6 +23,8 @@ py::dict simulate_py(const lptv::Model& model, const Eigen::MatrixXcd& U, const 
   d["truncation_error"] = r.truncation_error;
   d["converged"] = r.converged;
   d["solver"] = lptv::solver_name(r.solver);
+  d["condition"] = r.condition;
+  d["condition_line"] = r.condition_line;
   return d;
 }
 
@@ -43,6 +45,8 @@ Eigen::SparseMatrix<std::complex<double>> band_py(const lptv::Model& model, int 
 void bind_fds(py::module_& m) {
   m.def("simulate", &simulate_py, "model"_a, "U"_a, "solver"_a = "auto", "lines_out"_a = -1,
         "guard"_a = -1, "tol"_a = 1e-13, "max_guard"_a = -1);
+  m.attr("FDS_WARN_CONDITION") = lptv::Fds::kWarnCondition;
+  m.attr("FDS_MAX_CONDITION") = lptv::Fds::kMaxCondition;
   m.def("htf", &htf_py, "model"_a, "L"_a, "lines"_a, "solver"_a = "auto");
   m.def("band_matrix", &band_py, "model"_a, "L"_a, "a"_a = true);
   m.def("default_solver", [](bool discrete) { return lptv::solver_name(lptv::default_solver(discrete)); },

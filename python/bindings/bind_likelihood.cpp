@@ -22,7 +22,14 @@ void bind_likelihood(py::module_& m) {
       .def("residue_covariance", &lptv::ExactLikelihood::residue_covariance, "theta"_a)
       .def_property_readonly("sorted_rows", &lptv::ExactLikelihood::sorted_rows)
       .def_property_readonly("half_bandwidth", &lptv::ExactLikelihood::half_bandwidth);
-  m.def("cramer_rao_bound", &lptv::cramer_rao_bound, "noiseless"_a, "par"_a, "rows"_a, "theta"_a,
-        py::call_guard<py::gil_scoped_release>());
+  m.def("cramer_rao_bound",
+        py::overload_cast<const lptv::FrequencyData&, const lptv::Parametrisation&, const std::vector<int>&,
+                          const Eigen::VectorXcd&>(&lptv::cramer_rao_bound),
+        "noiseless"_a, "par"_a, "rows"_a, "theta"_a, py::call_guard<py::gil_scoped_release>());
+  m.def("cramer_rao_bound_experiments",
+        py::overload_cast<const std::vector<lptv::FrequencyData>&, const lptv::Parametrisation&,
+                          const std::vector<std::vector<int>>&, const Eigen::VectorXcd&>(&lptv::cramer_rao_bound),
+        "noiseless"_a, "par"_a, "rows"_a, "theta"_a, py::call_guard<py::gil_scoped_release>(),
+        "The Cramer-Rao bound of several independent experiments: their informations add.");
   m.def("eta_covariance", &lptv::eta_covariance, "par"_a, "cov_free"_a);
 }

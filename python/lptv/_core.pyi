@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['EstimateResult', 'ExactLikelihood', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'crest_factor', 'default_solver', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'DataDiagnosis', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -246,6 +246,9 @@ class Identification:
     def eta_names(self) -> list[str]:
         ...
     @property
+    def experiment(self) -> list[int]:
+        ...
+    @property
     def fraction_above_0db(self) -> float:
         ...
     @property
@@ -262,6 +265,9 @@ class Identification:
         ...
     @property
     def model(self) -> Model:
+        ...
+    @property
+    def n_experiments(self) -> int:
         ...
     @property
     def n_free(self) -> int:
@@ -292,6 +298,53 @@ class Identification:
         ...
     @property
     def theta(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def warnings(self) -> list[str]:
+        ...
+class ChannelPower:
+    """
+    Signal of one channel on a set of lines (lptv::channel_power).
+    """
+    @property
+    def above(self) -> int:
+        ...
+    @property
+    def clear(self) -> bool:
+        ...
+    @property
+    def limit(self) -> float:
+        ...
+    @property
+    def lines(self) -> int:
+        ...
+    @property
+    def noise(self) -> float:
+        ...
+    @property
+    def power(self) -> float:
+        ...
+    @property
+    def present(self) -> bool:
+        ...
+class DataDiagnosis:
+    """
+    What the data can say before estimating (lptv::diagnose_data).
+    """
+    @property
+    def excited(self) -> list[int]:
+        ...
+    @property
+    def informative_rows(self) -> int:
+        ...
+    @property
+    def input(self) -> ChannelPower:
+        ...
+    @property
+    def output(self) -> ChannelPower:
+        ...
+    @property
+    def region(self) -> list[int]:
         ...
     @property
     def warnings(self) -> list[str]:
@@ -354,10 +407,18 @@ def covariance_correction(periods: typing.SupportsInt | typing.SupportsIndex) ->
     ...
 def cramer_rao_bound(noiseless: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+def cramer_rao_bound_experiments(noiseless: collections.abc.Sequence[FrequencyData], par: Parametrisation, rows: collections.abc.Sequence[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    The Cramer-Rao bound of several independent experiments: their informations add.
+    """
 def crest_factor(x: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> float:
     ...
 def default_solver(discrete: bool = False) -> str:
     ...
+def diagnose_data(data: FrequencyData, structure: Structure, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], check_row_count: bool = True) -> DataDiagnosis:
+    """
+    The data diagnostics lptv::identify runs first: raises ValueError naming the argument and the cause for degenerate data (METHOD.md section 15).
+    """
 def estimate(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50) -> EstimateResult:
     ...
 def eta_covariance(par: Parametrisation, cov_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
@@ -378,6 +439,13 @@ def htf_estimate(data: FrequencyData, excited: collections.abc.Sequence[typing.S
     ...
 def identify(data: FrequencyData, structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] = [], covariance: bool = True) -> Identification:
     ...
+def identify_experiments(experiments: collections.abc.Sequence[FrequencyData], structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]] = [], covariance: bool = True) -> Identification:
+    """
+    Several experiments of one system fitted into one model (lptv::identify on a list).
+    
+    rows: one list of rows per experiment (an empty list: that experiment's default rows), or
+    empty for every experiment's default.
+    """
 def jacobian(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
 def monodromy(model: Model, steps: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
@@ -403,3 +471,5 @@ def time_signal(X: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[
     ...
 def weighted_r_factor(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+FDS_MAX_CONDITION: float = 10000000000000.0
+FDS_WARN_CONDITION: float = 100000000.0

@@ -135,3 +135,41 @@ def frequency_data_of(u, y, w0, ts) -> "FrequencyData":
     if w0 is None:
         raise ValueError("w0 is missing: the fundamental of the period (rad/s)")
     return FrequencyData.from_periods(u, y, w0=w0, ts=ts)
+
+
+def experiments_of(items, w0, ts) -> list:
+    """The data of several experiments of one system: ``items`` a list (or tuple) of
+    :class:`FrequencyData` and/or ``(u, y)`` pairs of P_e x N_e period arrays (``w0``, ``ts`` as for
+    one data set). Each experiment may have its own P and N; all must share the period (w0) and
+    the time domain (continuous, or discrete with one sample period)."""
+    if not isinstance(items, (list, tuple)):
+        raise ValueError(f"experiments must be a list of FrequencyData or (u, y) pairs, got {type(items).__name__}")
+    if len(items) == 0:
+        raise ValueError("experiments: the list is empty (give one or more FrequencyData or (u, y) pairs)")
+    datas = []
+    for i, item in enumerate(items):
+        if isinstance(item, FrequencyData):
+            args = (item, None)
+        elif isinstance(item, (list, tuple)) and len(item) == 2:
+            args = tuple(item)
+        else:
+            raise ValueError(f"experiments[{i}] must be a FrequencyData or a (u, y) pair of period arrays, "
+                             f"got {type(item).__name__}" + (f" of length {len(item)}"
+                                                             if isinstance(item, (list, tuple)) else ""))
+        try:
+            datas.append(frequency_data_of(args[0], args[1], w0, ts))
+        except ValueError as e:
+            raise ValueError(f"experiments[{i}]: {e}") from None
+    first = datas[0]
+    for i, d in enumerate(datas[1:], start=1):
+        if not np.isclose(d.w0, first.w0, rtol=1e-9, atol=0):
+            raise ValueError(f"experiments disagree on the period: experiments[0] has w0 = {first.w0:.10g} rad/s, "
+                             f"experiments[{i}] has w0 = {d.w0:.10g} rad/s (one model needs one period)")
+        if (d.ts is None) != (first.ts is None):
+            kind = lambda x: "continuous time (no ts)" if x.ts is None else f"discrete time (ts = {x.ts:g})"
+            raise ValueError(f"experiments mix time domains: experiments[0] is {kind(first)}, "
+                             f"experiments[{i}] is {kind(d)}")
+        if d.ts is not None and not np.isclose(d.ts, first.ts, rtol=1e-9, atol=0):
+            raise ValueError(f"experiments disagree on the sample period of the discrete-time model: "
+                             f"experiments[0] has ts = {first.ts:g}, experiments[{i}] has ts = {d.ts:g}")
+    return datas

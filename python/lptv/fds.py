@@ -11,11 +11,26 @@ from . import _core
 from ._validate import as_int, as_positive_float, as_spectrum, as_str
 
 SOLVERS = ("auto", "band", "klu", "umfpack")
+from .floquet import UnstableModelWarning, unstable_warning_text
 from .model import Model
 
 
 class TruncationWarning(UserWarning):
     """The adaptive guard did not bring the truncation error below the tolerance."""
+
+
+class ConditioningWarning(UserWarning):
+    """The band system is nearly singular next to a line that carries output: a pole within a
+    relative distance of about 1 / condition of the line (a nearly undamped resonance). The
+    output there is amplified about ``condition`` times and is as sensitive to the
+    coefficients; more than half of the 16 digits are lost."""
+
+
+CONDITION_WARN = float(_core.FDS_WARN_CONDITION)
+"""Condition number (relative to the coefficients on the line) above which :func:`simulate`
+warns (1e8: more than half the digits lost, 1 / sqrt(eps) = 6.7e7 rounded up)."""
+CONDITION_MAX = float(_core.FDS_MAX_CONDITION)
+"""Above this :func:`simulate` refuses with :class:`lptv.NumericalError` (1e13: fewer than 3 digits)."""
 
 
 @dataclass(frozen=True)
@@ -32,6 +47,12 @@ class SimulationResult:
     """Whether the truncation error met ``tol``."""
     solver: str
     """Factorisation used ('band', 'klu' or 'umfpack')."""
+    condition: float = float("nan")
+    """Componentwise condition number of the band system relative to the model's coefficients
+    (max over the lines of sum |terms| / |result|; an LTI model: over the lines with input), a
+    lower estimate: about log10(condition) of the 16 digits are lost."""
+    condition_line: int = 0
+    """The line where ``condition`` peaks."""
 
 
 def _check_model(model, name="model"):
@@ -42,7 +63,7 @@ def _check_model(model, name="model"):
 
 def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optional[int] = None,
              tol: float = 1e-13, max_guard: Optional[int] = None, solver: str = "auto",
-             full_output: bool = False):
+             full_output: bool = False, warn_unstable: bool = True):
     """Steady-state output spectrum of ``model`` for the input spectrum ``U``.
 
     Solves the band system ``A Y = B U`` (METHOD.md eq. 5) with one sparse LU. The result is
@@ -71,10 +92,32 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
         so 'band' is refused there).
     full_output : bool
         Return a :class:`SimulationResult` instead of ``Y``.
+    warn_unstable : bool
+        Check the model's stability (the roots of a for an LTI model, :func:`lptv.floquet`
+        otherwise; once per model object) and warn when it is unstable. False skips the check.
 
     Returns
     -------
     Y : ndarray, same shape as U (rows up to ``lines_out``)
+
+    Raises
+    ------
+    lptv.NumericalError
+        A is numerically singular (condition above :data:`CONDITION_MAX` = 1e13 relative to
+        the coefficients on a line): a pole on, or within rounding of, a grid line, or a_na(t)
+        nearly vanishes; the message names the line.
+
+    Warns
+    -----
+    lptv.UnstableModelWarning
+        The model is unstable: the periodic solution is returned, but a simulation from rest
+        never settles into it.
+    lptv.ConditioningWarning
+        The condition is above :data:`CONDITION_WARN` = 1e8 on a line with output (an LTI
+        model: a line with input): a nearly undamped resonance there; the message names the
+        line. The result is returned (``condition`` in ``full_output``).
+    TruncationWarning
+        The adaptive guard did not reach ``tol``.
 
     Examples
     --------
@@ -91,6 +134,8 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     max_guard = -1 if max_guard is None else as_int(max_guard, "max_guard")
     tol = as_positive_float(tol, "tol")
     solver = as_str(solver, "solver", SOLVERS)
+    if not isinstance(warn_unstable, (bool, np.bool_)):
+        raise TypeError(f"warn_unstable must be True or False, got {type(warn_unstable).__name__}")
     r = _core.simulate(model._cpp, Ua, solver=solver, lines_out=lines_out, guard=guard, tol=tol,
                        max_guard=max_guard)
     Y = np.asarray(r["Y"])
@@ -101,10 +146,31 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
             f"FDS truncation error {r['truncation_error']:.2e} is above tol={tol:g} "
             f"with {r['guard']} guard lines; pass a larger max_guard or guard",
             TruncationWarning, stacklevel=2)
+    cl = int(r["condition_line"])
+    # a line whose output is exactly zero (no input reaches it) loses nothing to its pole
+    silent = cl < Y.shape[0] and not np.any(np.asarray(r["Y"])[cl])
+    if r["condition"] > CONDITION_WARN and not silent:
+        warnings.warn(
+            f"the steady state is nearly singular on line {r['condition_line']} (condition "
+            f"{r['condition']:.2g} relative to the model's coefficients there, warning above "
+            f"{CONDITION_WARN:.0e}): a pole within a relative distance of about "
+            f"{1 / r['condition']:.1g} of that line, e.g. a nearly undamped resonance; the output "
+            f"there is amplified about {r['condition']:.1g} times and a relative change of "
+            f"{1 / r['condition']:.1g} in the coefficients changes it by its own size",
+            ConditioningWarning, stacklevel=2)
+    if warn_unstable:
+        _warn_unstable(model)
     if full_output:
         return SimulationResult(Y=Y, guard=r["guard"], truncation_error=r["truncation_error"],
-                                converged=r["converged"], solver=r["solver"])
+                                converged=r["converged"], solver=r["solver"],
+                                condition=float(r["condition"]), condition_line=int(r["condition_line"]))
     return Y
+
+
+def _warn_unstable(model: Model) -> None:
+    text = unstable_warning_text(model)
+    if text is not None:
+        warnings.warn(text, UnstableModelWarning, stacklevel=3)
 
 
 MAX_GRID_LINES = 2 ** 26

@@ -10,7 +10,8 @@ from typing import Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _core
-from .data import FrequencyData, frequency_data_of
+from .data import FrequencyData, experiments_of, frequency_data_of
+from .floquet import UnstableModelWarning, unstable_warning_text
 from .model import Model
 from ._validate import as_positive_float
 
@@ -19,6 +20,13 @@ METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 
 class IdentifiabilityWarning(UserWarning):
     """The two smallest generalised singular values are close: the model is nearly unidentifiable."""
+
+
+def _cost_limit(P: int) -> float:
+    """3 times the cost's noise level (P-1)/(P-2); 10 for P = 2, 3 for known variances."""
+    if P == 0:
+        return 3.0
+    return 10.0 if P == 2 else 3.0 * (P - 1) / (P - 2)
 
 
 @dataclass(frozen=True)
@@ -66,7 +74,26 @@ class IdentificationResult:
     corrected for noise variances estimated from the periods (see :func:`covariance_correction`);
     None for LS, TLS and GTLS."""
     nearly_unidentifiable: bool = False
-    """The two smallest generalised singular values are close while the residue test passes."""
+    """The two smallest generalised singular values are close while the residue test passes (LS,
+    TLS: those of the GTLS problem on the same lines, whatever the residues); see :attr:`undetermined`."""
+    unstable: Optional[str] = None
+    """A sentence when the identified model is unstable (a Floquet multiplier outside the unit
+    circle; also warned as :class:`lptv.UnstableModelWarning`), None otherwise. Steady-state data
+    of a stabilised experiment identify an unstable system correctly; the sentence says what its
+    predicted output means."""
+    experiment: Optional[np.ndarray] = field(default=None, repr=False)
+    """Per row of ``lines``: the index of the experiment it belongs to (all 0 for one data set)."""
+    experiments: Tuple[FrequencyData, ...] = field(default_factory=tuple, repr=False)
+    """Several experiments fitted together: their data in the order given (``data`` is then None)."""
+
+    @property
+    def n_experiments(self) -> int:
+        """How many experiments (data sets) the fit used."""
+        return max(len(self.experiments), 1)
+
+    def _rows_of(self, e: int) -> np.ndarray:
+        """Positions in ``lines`` of experiment e's rows."""
+        return np.flatnonzero(self.experiment == e)
 
     @property
     def parameter_std(self) -> Optional[np.ndarray]:
@@ -112,29 +139,59 @@ class IdentificationResult:
 
     # -- the verdict --------------------------------------------------------------
     @cached_property
-    def verdict_lines(self) -> np.ndarray:
-        """The rows the verdict judges: the fit rows at the excited lines (and within +-K of them
-        for an LPTV model); all fit rows when no line stands above the input noise."""
-        if self.data is None:
-            return self.lines
+    def verdict_mask(self) -> np.ndarray:
+        """Per row of ``lines``: does the verdict judge it (see :attr:`verdict_lines`)? With
+        several experiments each experiment's own excited lines."""
         K = max(self.model.ka, self.model.kb)
+        if self.experiments:
+            mask = np.zeros(self.lines.size, bool)
+            for e, d in enumerate(self.experiments):
+                idx = self._rows_of(e)
+                try:
+                    mask[idx] = np.isin(self.lines[idx], excited_rows(d, K))
+                except ValueError:
+                    mask[idx] = True
+            return mask if mask.any() else np.ones(self.lines.size, bool)
+        if self.data is None:
+            return np.ones(self.lines.size, bool)
         try:
             ex = excited_rows(self.data, K)
         except ValueError:
-            return self.lines
-        sel = self.lines[np.isin(self.lines, ex)]
-        return sel if sel.size else self.lines
+            return np.ones(self.lines.size, bool)
+        mask = np.isin(self.lines, ex)
+        return mask if mask.any() else np.ones(self.lines.size, bool)
+
+    @cached_property
+    def verdict_lines(self) -> np.ndarray:
+        """The rows the verdict judges: the fit rows at the excited lines (and within +-K of them
+        for an LPTV model); all fit rows when no line stands above the input noise. With several
+        experiments, each experiment's own excited lines, in the order of ``lines``."""
+        return self.lines[self.verdict_mask]
+
+    def _periods(self) -> np.ndarray:
+        """P per row of ``lines`` (0: statistics from elsewhere)."""
+        if self.experiments:
+            return np.array([d.periods for d in self.experiments])[self.experiment]
+        return np.full(self.lines.size, self.data.periods if self.data is not None else 0)
 
     @cached_property
     def _verdict_stats(self):
-        mask = np.isin(self.lines, self.verdict_lines)
+        mask = self.verdict_mask
         r = self.normalized_residue[mask]
         n = int(mask.sum())
         frac = float(np.mean(r > 1.0)) if n else float("nan")
-        P = self.data.periods if self.data is not None else 0
         n_free = int(round(self.n_free_parameters * n / max(self.lines.size, 1)))
+        periods = self._periods()[mask]
         try:
-            expected, band = _core.expected_fraction_above_0db(n, n_free, P)
+            if np.all(periods == periods[0]):
+                expected, band = _core.expected_fraction_above_0db(n, n_free, int(periods[0]))
+            else:
+                # Rows of experiments with different P: each row's own probability, the band
+                # +-3 standard deviations of the count (as the core's fraction over all rows).
+                p = np.array([_core.expected_fraction_above_0db(n, n_free, int(P))[0] for P in periods])
+                expected = float(p.mean())
+                half = 3.0 * np.sqrt(np.sum(p * (1 - p))) / n
+                band = (max(0.0, expected - half), min(1.0, expected + half))
         except Exception:
             expected, band = self.fraction_expected, self.fraction_band
         return frac, float(expected), tuple(band)
@@ -157,31 +214,40 @@ class IdentificationResult:
         cost is not normalised by the noise."""
         if self.method not in ("wgtls", "sml") or self.noise_free:
             return None
-        P = self.data.periods if self.data is not None else 0
-        if P == 0:
-            return 3.0
-        return 10.0 if P == 2 else 3.0 * (P - 1) / (P - 2)
+        if self.experiments:  # the cost is a mean over the rows: their limits' mean
+            limits = [_cost_limit(P) for P in self._periods()]
+            return float(np.mean(limits))
+        return _cost_limit(self.data.periods if self.data is not None else 0)
 
     @cached_property
     def prediction_error_db(self) -> Optional[float]:
         """Mean power of Y - Y_model (the model's output from the measured mean input) over the
         variance of the mean output, on :attr:`verdict_lines`, in dB (about 0 dB for a model the
         noise explains). None without data or where it cannot be computed."""
-        if self.data is None:
+        datas = self.experiments or ((self.data,) if self.data is not None else ())
+        if not datas:
             return None
         from .fds import simulate
 
-        rows = self.verdict_lines
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                Yp = np.asarray(simulate(self.model, self.data.U))
-        except Exception:
+        experiment = self.experiment if self.experiments else np.zeros(self.lines.size, int)
+        err, noise = [], []
+        for e, d in enumerate(datas):
+            rows = self.lines[self.verdict_mask & (experiment == e)]
+            if rows.size == 0:
+                continue
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    Yp = np.asarray(simulate(self.model, d.U, warn_unstable=False))
+            except Exception:
+                return None
+            if Yp.shape != d.Y.shape:
+                return None
+            err.append(np.abs(d.Y[rows] - Yp[rows]) ** 2)
+            noise.append(d.varY[rows])
+        if not err:
             return None
-        if Yp.shape != self.data.Y.shape:
-            return None
-        err = float(np.mean(np.abs(self.data.Y[rows] - Yp[rows]) ** 2))
-        noise = float(np.mean(self.data.varY[rows]))
+        err, noise = float(np.mean(np.concatenate(err))), float(np.mean(np.concatenate(noise)))
         if not (noise > 0 and err > 0):
             return None
         return float(10 * np.log10(err / noise))
@@ -214,12 +280,35 @@ class IdentificationResult:
         return not self.model_errors
 
     @property
+    def undetermined(self) -> Optional[str]:
+        """Why the data do not determine the estimate (None when they do).
+
+        A residue test has no power when the noise explains anything: at a signal-to-noise ratio
+        near 0 dB every model passes it. What exposes such a fit is the identifiability test of
+        the core (:attr:`nearly_unidentifiable`: the two smallest generalised singular values of
+        the noise-weighted problem are within the Marchenko-Pastur band of a noise-only
+        subspace, i.e. a second parameter direction explains the data as well as the estimate;
+        for LS and TLS the GTLS problem on the same lines is tested). The verdict then does not
+        call the model consistent."""
+        if self.nearly_unidentifiable:
+            sv = self.singular_values
+            vals = f" ({sv[0]:.3g}, {sv[1]:.3g})" if sv.size >= 2 and self.method != "ls" else ""
+            return ("the data do not determine the model: a second parameter direction explains them "
+                    f"as well as the estimate (the two smallest generalised singular values are close{vals}); "
+                    "too little signal above the noise, too many harmonics or too high orders")
+        return None
+
+    @property
     def verdict(self) -> str:
-        """One sentence: is the model consistent with the noise, and if not, why."""
-        if self.model_ok:
+        """One sentence: is the model consistent with the noise, and if not, why. A fit the data
+        do not determine (:attr:`undetermined`) is never called consistent."""
+        if self.model_ok and self.undetermined is None:
             return ("the model is consistent with the noise: the fit shows no sign of modelling errors "
                     f"(on the {self.verdict_lines.size} excited lines)")
-        return "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+        if self.model_ok:
+            return "NOT DETERMINED: no sign of modelling errors, but " + self.undetermined
+        out = "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
+        return out + ("; and " + self.undetermined if self.undetermined else "")
 
     def parameters(self, level: float = 0.95):
         """The parameter table: see :func:`lptv.parameter_table`."""
@@ -232,6 +321,12 @@ class IdentificationResult:
         verdict = "in the predicted band" if self.residue_ok else "OUTSIDE the predicted band"
         lines = [
             f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} lines",
+        ]
+        if self.experiments:
+            lines.append(f"{self.n_experiments} experiments fitted together: " + "; ".join(
+                f"#{e}: {self._rows_of(e).size} lines, P = {d.periods}, lines 0..{d.max_line}"
+                for e, d in enumerate(self.experiments)))
+        lines += [
             f"iterations {self.iterations}, converged {self.converged}, cost {self.cost:.4g}",
             f"normalised residue above 0 dB: {100 * self.fraction_above_0db:.1f} % "
             f"(expected {100 * self.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %): {verdict}",
@@ -243,6 +338,8 @@ class IdentificationResult:
         lines.append(format_parameter_table(self))
         lines.append(f"verdict: {self.verdict}")
         lines += [f"warning: {w}" for w in self.warnings]
+        if self.unstable:
+            lines.append(f"warning: {self.unstable}")
         return "\n".join(lines)
 
 
@@ -347,7 +444,11 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ----------
     u, y : array_like, shape (P, N)
         P >= 2 steady-state periods of input and output. Or pass a :class:`FrequencyData`
-        as ``u`` (and no ``y``).
+        as ``u`` (and no ``y``). Or, for several experiments on the same system fitted into one
+        model, a list as ``u`` (and no ``y``) of :class:`FrequencyData` and/or ``(u, y)`` pairs
+        of P_e x N_e period arrays: each may have its own P, N and excitation, all share the
+        period (``w0``) and the time domain (METHOD.md section 14). The result's
+        ``experiment`` says which experiment each row of ``lines`` belongs to.
     na, nb : int
         Orders of the output and input sides.
     ka, kb : int or sequence of int
@@ -361,7 +462,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         largest harmonic count; kept as the library's default so that existing scripts give the
         same numbers. ``'excited'``: the lines the input excites (power 100 times above its
         noise) and, for an LPTV model, the lines within +-K of them (:func:`excited_rows`);
-        this is what ``lptv identify FILE`` uses by default. Whatever the rows, the verdict
+        this is what ``lptv identify FILE`` uses by default. With several experiments: None or
+        'excited' for every experiment, or a list with one entry (None, 'excited' or a
+        sequence of lines) per experiment. Whatever the rows, the verdict
         (:attr:`IdentificationResult.verdict`) judges the residues on the excited lines, so that
         lines holding only noise do not dilute a model error.
     method : {'ls', 'tls', 'gtls', 'wgtls', 'sml'}
@@ -375,6 +478,28 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     tol, max_iter :
         WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
         ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
+
+    Raises
+    ------
+    ValueError
+        Besides bad arguments, degenerate data, diagnosed before estimating (METHOD.md section
+        14), with the argument and the cause: no input power on the fitted lines ("u: ... zero",
+        "u: ... at the level of its noise", or "u: the input is not excited on the fitted lines
+        ... it is excited on lines ..."), an output without variation there ("y: ..."), fewer
+        rows carrying signal than the parameters need ("lines: ..."), known coefficients that
+        cannot fix the scale or that zero a_na ("known: ...").
+    lptv.NumericalError
+        A decomposition failed on data that passed the diagnostics (the message says which).
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        The data do not determine the model (also :attr:`IdentificationResult.undetermined`; the
+        verdict then never says "consistent").
+    lptv.UnstableModelWarning
+        The identified model is unstable (also :attr:`IdentificationResult.unstable`).
+    UserWarning
+        The core's other warnings (:attr:`IdentificationResult.warnings`).
 
     Examples
     --------
@@ -391,7 +516,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    data = frequency_data_of(u, y, w0, ts)
+    several = y is None and isinstance(u, (list, tuple))
+    if several:
+        datas = experiments_of(u, w0, ts)
+        data = datas[0]
+    else:
+        data = frequency_data_of(u, y, w0, ts)
     ts = data.ts if ts is None else ts
     for name, v in (("na", na), ("nb", nb)):
         if np.ndim(v) != 0 or int(v) != v or v < 0:
@@ -404,17 +534,30 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
-    if isinstance(lines, str):
-        if lines != "excited":
-            raise ValueError(f"lines must be a sequence of integers or 'excited', got {lines!r}")
-        lines = excited_rows(data, max(ka_l + kb_l))
-    rows = [] if lines is None else _rows(lines)
-    r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter), rows=rows)
+    if several:
+        rows = _experiment_rows(datas, lines, max(ka_l + kb_l))
+        r = _core.identify_experiments([d._cpp for d in datas], structure, method=method, tol=float(tol),
+                                       max_iter=int(max_iter), rows=rows)
+    else:
+        if isinstance(lines, str):
+            if lines != "excited":
+                raise ValueError(f"lines must be a sequence of integers or 'excited', got {lines!r}")
+            lines = excited_rows(data, max(ka_l + kb_l))
+        rows = [] if lines is None else _rows(lines)
+        r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter),
+                           rows=rows)
     for msg in r.warnings:
         unident = r.nearly_unidentifiable and "unidentifiable" in msg
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
     cov = r.covariance
     model = Model._from_core(r.model)
+    unstable = unstable_warning_text(model)
+    if unstable is not None:
+        # said once here; the verdict's own simulation of the estimate stays silent
+        unstable = ("the identified " + unstable[len("the "):].split(": the periodic")[0]
+                    + ": its predicted steady state is the periodic solution of its equation, which "
+                    "a simulation from rest does not reach (fine for data from a stabilised experiment)")
+        warnings.warn(unstable, UnstableModelWarning, stacklevel=2)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -424,5 +567,36 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         residue=np.asarray(r.residue), residue_variance=np.asarray(r.residue_variance),
         normalized_residue=np.asarray(r.normalized_residue), fraction_above_0db=r.fraction_above_0db,
         fraction_expected=r.fraction_expected, fraction_band=tuple(r.fraction_band), noise_free=r.noise_free,
-        warnings=tuple(r.warnings), data=data, eta_names=tuple(r.eta_names),
-        covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable)
+        warnings=tuple(r.warnings), data=None if several else data, eta_names=tuple(r.eta_names),
+        covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
+        experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
+        unstable=unstable)
+
+
+def _experiment_rows(datas, lines, K):
+    """The rows of each experiment for the core: [] means that experiment's default rows."""
+    E = len(datas)
+    if lines is None:
+        return [[] for _ in range(E)]
+    if isinstance(lines, str):
+        entries = [lines] * E
+    else:
+        if not isinstance(lines, (list, tuple)) or len(lines) != E or not all(
+                v is None or isinstance(v, str) or np.ndim(v) == 1 for v in lines):
+            raise ValueError(f"lines: with {E} experiments give None, 'excited', or a list of {E} entries "
+                             "(None, 'excited' or a sequence of lines), one per experiment")
+        entries = list(lines)
+    rows = []
+    for e, (v, d) in enumerate(zip(entries, datas)):
+        try:
+            if v is None:
+                rows.append([])
+            elif isinstance(v, str):
+                if v != "excited":
+                    raise ValueError(f"lines must be a sequence of integers or 'excited', got {v!r}")
+                rows.append([int(x) for x in excited_rows(d, K)])
+            else:
+                rows.append(_rows(v))
+        except ValueError as err:
+            raise ValueError(f"lines[{e}] (experiment {e}): {err}") from None
+    return rows

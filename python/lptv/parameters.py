@@ -326,7 +326,7 @@ def compare(obj, u, y):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        Y = simulate(model, spectrum(um))
+        Y = simulate(model, spectrum(um), warn_unstable=False)
     yhat = time_signal(np.asarray(Y)[: N // 2 + 1], N)
     den = np.linalg.norm(ym - ym.mean())
     fit = 100.0 * (1.0 - np.linalg.norm(ym - yhat) / den) if den > 0 else float("nan")

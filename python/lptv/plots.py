@@ -282,6 +282,8 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
     """Bode plot of an identification: the measured FRF ``Y / U`` on the excited lines with +-2
     standard deviations (from the periods' noise), the model's (time-averaged) frequency response
     and its ``level`` band from the parameter covariance. Log-frequency axis in rad/s (or Hz).
+    For a fit of several experiments, each experiment's measured FRF on its own excited lines,
+    with its own marker.
 
     Returns the figure (magnitude on top, phase below).
     """
@@ -293,16 +295,19 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
 
         fig = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
-    d, model = res.data, res.model
-    rows = np.asarray(res.verdict_lines)
-    U, Y = d.U[rows], d.Y[rows]
-    G = Y / U
-    varG = (d.varY[rows] + np.abs(G) ** 2 * d.varU[rows] - 2 * np.real(np.conj(G) * d.covYU[rows])) / np.abs(U) ** 2
-    sG = np.sqrt(np.maximum(varG, 0.0))
-    w_lines = rows * model.w0
+    model = res.model
+    if res.data is not None:
+        sets = [("measured Y/U (+-2 std)", res.data, np.asarray(res.verdict_lines))]
+    else:  # several experiments: each one's measured FRF on its own excited lines
+        mask, exp = res.verdict_mask, np.asarray(res.experiment)
+        sets = [(f"experiment {e} Y/U (+-2 std)", d, res.lines[mask & (exp == e)])
+                for e, d in enumerate(res.experiments)]
+        sets = [s for s in sets if s[2].size]
+    all_lines = np.concatenate([s[2] for s in sets])
+    w_all = all_lines * model.w0
     scale = 1 / (2 * np.pi) if hz else 1.0
-    wmax = np.pi / model.ts if model.discrete else w_lines.max() * 1.5
-    w = np.logspace(np.log10(w_lines.min() / 1.5), np.log10(min(wmax, w_lines.max() * 1.5)), n_points)
+    wmax = np.pi / model.ts if model.discrete else w_all.max() * 1.5
+    w = np.logspace(np.log10(w_all.min() / 1.5), np.log10(min(wmax, w_all.max() * 1.5)), n_points)
     H, s_abs, s_ph = freqresp_band(res, w)
     z = norm.ppf(0.5 + level / 2)
     x = w * scale
@@ -311,18 +316,35 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
                           color="C1", alpha=0.3, lw=0, label=f"model {100 * level:g} % band")
         ax_p.fill_between(x, np.degrees(np.unwrap(np.angle(H)) - z * s_ph),
                           np.degrees(np.unwrap(np.angle(H)) + z * s_ph), color="C1", alpha=0.3, lw=0)
-    ax_m.errorbar(w_lines * scale, _db(G), yerr=[_db(np.abs(G)) - _db(np.maximum(np.abs(G) - 2 * sG, 1e-300 + 0 * sG)),
-                                                   _db(np.abs(G) + 2 * sG) - _db(G)],
-                  fmt="o", ms=3.5, mfc="none", color="C0", elinewidth=0.8, label="measured Y/U (+-2 std)")
-    ax_m.plot(x, _db(H), "-", color="C1", lw=1.2, label="model")
-    ph_meas = np.degrees(np.angle(G))
     ph_model = np.degrees(np.unwrap(np.angle(H)))
-    # put the measured phase on the model's branch
-    ph_at = np.interp(w_lines, w, ph_model)
-    ph_meas = ph_meas + 360 * np.round((ph_at - ph_meas) / 360)
-    ax_p.errorbar(w_lines * scale, ph_meas, yerr=2 * np.degrees(sG / np.abs(G)), fmt="o", ms=3.5, mfc="none",
-                  color="C0", elinewidth=0.8)
+    markers = "osD^v<>"
+    for i, (label, d, rows) in enumerate(sets):
+        color = "C0" if i == 0 else f"C{i + 1}"  # C1 is the model's
+        U, Y = d.U[rows], d.Y[rows]
+        G = Y / U
+        varG = (d.varY[rows] + np.abs(G) ** 2 * d.varU[rows]
+                - 2 * np.real(np.conj(G) * d.covYU[rows])) / np.abs(U) ** 2
+        sG = np.sqrt(np.maximum(varG, 0.0))
+        w_lines = rows * model.w0
+        ax_m.errorbar(w_lines * scale, _db(G),
+                      yerr=[_db(np.abs(G)) - _db(np.maximum(np.abs(G) - 2 * sG, 1e-300 + 0 * sG)),
+                            _db(np.abs(G) + 2 * sG) - _db(G)],
+                      fmt=markers[i % len(markers)], ms=3.5, mfc="none", color=color, elinewidth=0.8, label=label)
+        # put the measured phase on the model's branch
+        ph_meas = np.degrees(np.angle(G))
+        ph_at = np.interp(w_lines, w, ph_model)
+        ph_meas = ph_meas + 360 * np.round((ph_at - ph_meas) / 360)
+        ax_p.errorbar(w_lines * scale, ph_meas, yerr=2 * np.degrees(sG / np.abs(G)),
+                      fmt=markers[i % len(markers)], ms=3.5, mfc="none", color=color, elinewidth=0.8)
+    ax_m.plot(x, _db(H), "-", color="C1", lw=1.2, label="model")
     ax_p.plot(x, ph_model, "-", color="C1", lw=1.2)
+    # The view follows the points and the model: an error bar reaching |G| = 0 (a line where the
+    # noise is as large as the response) would otherwise stretch the axis to -6000 dB.
+    shown = np.concatenate([_db(H)] + [_db(s[1].Y[s[2]] / s[1].U[s[2]]) for s in sets])
+    shown = shown[np.isfinite(shown)]
+    if shown.size:
+        span = max(float(shown.max() - shown.min()), 1.0)
+        ax_m.set_ylim(shown.min() - 0.15 * span - 3.0, shown.max() + 0.15 * span + 3.0)
     for ax in (ax_m, ax_p):
         ax.set_xscale("log")
         ax.grid(True, which="both", alpha=0.3)

@@ -18,6 +18,7 @@ matrix Phi), x0 = (I - Phi)^-1 x_forced(T0), then the period from x0 that is ret
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Optional
 
@@ -25,6 +26,7 @@ import numpy as np
 
 from ._core import NumericalError  # the exception type only; no computation of the core is used
 from ._validate import as_spectrum, check_finite
+from .floquet import UnstableModelWarning  # the warning class only
 from .model import Model
 
 __all__ = ["SteadyState", "Response", "periodic_steady_state", "free_response"]
@@ -111,15 +113,51 @@ def _input_spectrum(U, name):
     return arr
 
 
-def _solve_periodic(Phi, xf):
+# The periodic state solves (I - Phi) x0 = x_forced(T0). Phi is known only to its computation's
+# accuracy tau relative to 1 + ||Phi|| (continuous time: CVODE's global error, a modest multiple
+# of rtol for these well-resolved runs, hence 100 rtol; discrete time: N products of the
+# one-step maps, each rounding ~ eps, hence 100 N eps), so an I - Phi whose smallest singular
+# value is below tau (1 + ||Phi||) is singular within that accuracy and x0 is noise amplified by
+# 1 / sigma_min. The scale matters: an undamped oscillator whose period divides T0 has
+# Phi = I up to the integration error, ||I - Phi|| ~ 1e-11, and a harmless-looking condition
+# number, yet x0 ~ 1e12. The floor 1e-12 keeps the condition-number refusal this test replaced
+# (cond(I - Phi) > 1e12 implies sigma_min < (1 + ||Phi||) 1e-12).
+def _periodic_tolerance(model: Model, rtol: float) -> float:
+    if model.discrete:
+        return max(1e-12, 100.0 * model.samples_per_period * np.finfo(float).eps)
+    return max(1e-12, 100.0 * rtol)
+
+
+def _solve_periodic(Phi, xf, tau):
     if Phi.size == 0:
         return np.zeros(0)
     M = np.eye(Phi.shape[0]) - Phi
-    if np.linalg.cond(M) > 1e12:
-        raise NumericalError("I - Phi is (nearly) singular: the homogeneous equation has a "
-                             "(nearly) periodic solution, so the periodic steady state is not "
-                             f"unique (monodromy eigenvalues {np.linalg.eigvals(Phi)})")
+    scale = 1.0 + np.linalg.norm(Phi, 2)
+    smin = np.linalg.svd(M, compute_uv=False)[-1]
+    if not smin > tau * scale:
+        mu = np.linalg.eigvals(Phi)
+        near = mu[np.argmin(np.abs(mu - 1.0))]
+        raise NumericalError(
+            "I - Phi is singular within the accuracy of the monodromy matrix Phi (smallest "
+            f"singular value {smin:.3g}, relative to 1 + ||Phi|| = {scale:.3g}: {smin / scale:.2g}, "
+            f"below {tau:.2g}): a Floquet multiplier at 1 (nearest {near:.12g}), e.g. an undamped "
+            "resonance on a harmonic of w0 or a free integrator, so the homogeneous equation has a "
+            "periodic solution and the periodic steady state is not determined (add damping, or "
+            "move the resonance off the lines)")
+    _warn_if_unstable(Phi, tau)
     return np.linalg.solve(M, xf)
+
+
+def _warn_if_unstable(Phi, tau):
+    """Multipliers (eigenvalues of Phi) outside the unit circle by more than Phi's accuracy."""
+    mu = np.linalg.eigvals(Phi)
+    rho = float(np.abs(mu).max())
+    if rho > 1.0 + tau * (1.0 + np.linalg.norm(Phi, 2)):
+        warnings.warn(
+            f"the model is unstable (largest Floquet multiplier magnitude {rho:.6g} > 1): the "
+            "periodic steady state returned solves the equation but is not what a simulation "
+            "from rest reaches (deviations from it grow like "
+            f"{rho:.3g}**(t / T0))", UnstableModelWarning, stacklevel=5)
 
 
 def _periodicity_error(x_end, x0, y):
@@ -263,7 +301,7 @@ def _ct_steady_state(model, U, n_samples, options, atol):
     for i in range(na):
         Phi[:, i] = integ.run([0.0, T0], np.eye(na)[i], False, atol_h,
                               f"homogeneous period from unit state {i}")[-1]
-    x0 = _solve_periodic(Phi, xf)
+    x0 = _solve_periodic(Phi, xf, _periodic_tolerance(model, options["rtol"]))
     X = integ.run(np.append(t, T0), x0, True, atol_f, "period from the periodic state")
     y = X[:n_samples, 0]
     return t, y, x0, Phi, _periodicity_error(X[-1], x0, y), integ.n_rhs
@@ -329,7 +367,7 @@ def _dt_steady_state(model, U, n_samples):
     # The forced run and the na homogeneous runs share one recursion (one column each).
     Yall = _dt_recursion(model, u_of_k, 0, N, np.hstack([np.zeros((na, 1)), np.eye(na)]), True)
     Phi = Yall[N:, 1:]
-    x0 = _solve_periodic(Phi, Yall[N:, 0])
+    x0 = _solve_periodic(Phi, Yall[N:, 0], _periodic_tolerance(model, 0.0))
     Yp = _dt_recursion(model, u_of_k, 0, N, x0[:, None], True)[:, 0]
     y = Yp[:N]
     return np.arange(N), y, x0, Phi, _periodicity_error(Yp[N:], x0, y), 0
@@ -370,7 +408,16 @@ def periodic_steady_state(model: Model, U, n_samples: Optional[int] = None, *,
     ------
     lptv.NumericalError
         CVODE failed (too much work, accuracy out of reach, ...), a_na(t) vanishes, or the
-        homogeneous equation has a periodic solution (I - Phi singular).
+        homogeneous equation has a periodic solution: I - Phi is singular within the accuracy
+        of Phi (its smallest singular value below ``max(1e-12, 100 rtol)`` times
+        ``1 + ||Phi||``; discrete time ``max(1e-12, 100 N eps)``), e.g. an undamped resonance
+        on a harmonic of w0.
+
+    Warns
+    -----
+    lptv.UnstableModelWarning
+        A Floquet multiplier (eigenvalue of Phi) lies outside the unit circle by more than that
+        accuracy: the periodic solution is returned, but a simulation from rest never reaches it.
 
     Examples
     --------

@@ -24,7 +24,10 @@ class CramerRaoBound:
     """The true free real parameters (normalised as :func:`identify` normalises)."""
     eta_names: Tuple[str, ...]
     lines: np.ndarray
-    periods: int
+    periods: Union[int, Tuple[int, ...]]
+    """P (several experiments: one P per experiment)."""
+    experiment: Optional[np.ndarray] = None
+    """Per row of ``lines``: the index of its experiment (several experiments; None for one)."""
 
     @property
     def std(self) -> np.ndarray:
@@ -78,6 +81,12 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
         P: the measured periods; the spectra's means then have the (co)variances above / P.
     lines : sequence of int, optional
         The rows of the fit (default as :func:`identify`).
+
+    Several experiments (METHOD.md section 14): ``u`` a list of excitations (each its own lines
+    0..L_e); ``var_y``, ``var_u``, ``cov_yu``, ``periods`` and ``lines`` then either one value for
+    all or a list with one entry per experiment. The experiments are independent, so their
+    Fisher informations add; ``lines`` of the result runs over all experiments and
+    ``experiment`` says which experiment each row belongs to.
     ka, kb, known :
         The structure to estimate (default: the model's own orders and harmonic counts).
 
@@ -94,6 +103,18 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
     """
     if not isinstance(model, Model):
         raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+    if isinstance(u, (list, tuple)) and len(u) > 0 and all(
+            isinstance(x, Multisine) or np.ndim(x) == 1 for x in u):
+        return _crb_experiments(model, list(u), var_y=var_y, var_u=var_u, cov_yu=cov_yu, periods=periods,
+                                lines=lines, ka=ka, kb=kb, known=known)
+    data, par, rows, theta, xi, periods = _design(model, u, var_y, var_u, cov_yu, periods, lines, ka, kb, known)
+    cov = np.asarray(_core.cramer_rao_bound(data, par, rows, theta))
+    return CramerRaoBound(covariance=cov, eta=xi[:par.n_eta], eta_names=tuple(par.eta_names),
+                          lines=np.asarray(rows), periods=periods)
+
+
+def _design(model, u, var_y, var_u, cov_yu, periods, lines, ka, kb, known, check_count=True):
+    """One experiment's noiseless data, parametrisation, rows and true (normalised) parameters."""
     if isinstance(u, Multisine):
         U = u.spectrum
     else:
@@ -115,10 +136,44 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
     kn = _known_list(known, ka_l, kb_l)
     par = _core.Parametrisation(na, nb, ka_l, kb_l, kn, model.w0, 0.0 if model.ts is None else model.ts)
     rows = par.default_rows(data.max_line) if lines is None else _rows(lines)
-    par.check_rows(rows, data.max_line)
+    if check_count:  # several experiments: the core counts the equations over all of them
+        par.check_rows(rows, data.max_line)
     xi = np.asarray(par.xi_from_theta(np.asarray(par.theta_from_model(model._cpp))))
     theta = np.asarray(par.theta_from_xi(xi))   # normalised, as the estimates are
     xi = xi / xi[par.norm_index]
-    cov = np.asarray(_core.cramer_rao_bound(data, par, rows, theta))
+    return data, par, rows, theta, xi, periods
+
+
+def _crb_experiments(model, us, *, var_y, var_u, cov_yu, periods, lines, ka, kb, known) -> CramerRaoBound:
+    E = len(us)
+
+    def each(v, name):
+        if isinstance(v, (list, tuple)):
+            if len(v) != E:
+                raise ValueError(f"{name}: with {E} experiments give one value for all or a list of {E}, "
+                                 f"got {len(v)}")
+            return list(v)
+        return [v] * E
+
+    vys, vus, cyus, Ps = each(var_y, "var_y"), each(var_u, "var_u"), each(cov_yu, "cov_yu"), each(periods, "periods")
+    line_sets = [None] * E if lines is None else each(lines, "lines") if isinstance(lines, (list, tuple)) and len(
+        lines) == E and all(v is None or np.ndim(v) == 1 for v in lines) else None
+    if line_sets is None:
+        raise ValueError(f"lines: with {E} experiments give None or a list of {E} entries (None or a sequence "
+                         "of lines), one per experiment")
+    bounds = []
+    for e in range(E):
+        try:
+            # One experiment's data and rows, validated as for a single design.
+            bounds.append(_design(model, us[e], vys[e], vus[e], cyus[e], Ps[e], line_sets[e], ka, kb, known,
+                                  check_count=False))
+        except ValueError as err:
+            raise ValueError(f"experiment {e}: {err}") from None
+    par = bounds[0][1]
+    datas, rows = [b[0] for b in bounds], [b[2] for b in bounds]
+    theta, xi = bounds[0][3], bounds[0][4]
+    cov = np.asarray(_core.cramer_rao_bound_experiments(datas, par, rows, theta))
     return CramerRaoBound(covariance=cov, eta=xi[:par.n_eta], eta_names=tuple(par.eta_names),
-                          lines=np.asarray(rows), periods=periods)
+                          lines=np.concatenate([np.asarray(r) for r in rows]),
+                          periods=tuple(b[5] for b in bounds),
+                          experiment=np.repeat(np.arange(E), [len(r) for r in rows]))

@@ -102,3 +102,32 @@ TEST_CASE("band and sparse backends agree on an LPTV model", "[fds]") {
   REQUIRE(band.solver == lptv::Solver::Band);
   REQUIRE((band.Y - klu.Y).cwiseAbs().maxCoeff() <= 1e-13 * klu.Y.cwiseAbs().maxCoeff());
 }
+
+TEST_CASE("simulate reports the condition of the lines with input, and where", "[fds]") {
+  // s^2 + d s + wn^2 with wn = 1 on line 1 (w0 = 1): the line's condition is (2 + d) / d
+  const double d = 1e-12;
+  Eigen::MatrixXcd a(3, 1), b(1, 1);
+  a << 1.0, d, 1.0;
+  b << 1.0;
+  const lptv::Model m(a, b, 1.0);
+  Eigen::MatrixXcd U = Eigen::MatrixXcd::Zero(4, 1);
+  U(1, 0) = 0.5;
+  const auto r = lptv::simulate(m, U);
+  REQUIRE(r.condition > lptv::Fds::kWarnCondition);
+  REQUIRE(std::abs(r.condition - (2 + d) / d) <= 1e-12 * r.condition);
+  REQUIRE(r.condition_line == 1);
+  // input on line 3 only: LTI lines do not couple, line 1 loses nothing
+  U(1, 0) = 0.0;
+  U(3, 0) = 0.5;
+  const auto q = lptv::simulate(m, U);
+  REQUIRE(q.condition < lptv::Fds::kWarnCondition);
+  REQUIRE(q.condition_line == 3);
+  // an LPTV model (b(t) time-varying) reports the grid's maximum, on line 1
+  Eigen::MatrixXcd bt(1, 3);
+  bt << 0.2, 1.0, 0.2;
+  U(3, 0) = 0.0;
+  U(2, 0) = 0.5;
+  const auto p = lptv::simulate(lptv::Model(a, bt, 1.0), U);
+  REQUIRE(p.condition > lptv::Fds::kWarnCondition);
+  REQUIRE(p.condition_line == 1);
+}

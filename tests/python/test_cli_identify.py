@@ -328,11 +328,12 @@ def test_period_must_be_known_and_agree_with_the_file(small, tmp_path, capsys):
     _check_one_line_error(rc, out, err, src, "--period gives w0 = 6.283185307 rad/s but the file says w0 = 2")
 
 
-def test_numerical_error_from_the_library(tmp_path, capsys):
-    # All-zero records: the estimate has a zero leading coefficient and cannot be normalised.
+def test_degenerate_record_error_from_the_library(tmp_path, capsys):
+    # All-zero records: the library's data diagnostics name the dead input (this used to surface
+    # as a failed normalisation), passed on in one line with the file name.
     src = _npz(tmp_path, u=np.zeros((4, 64)), y=np.zeros((4, 64)))
     rc, out, err = identify_cli(capsys, src, *SMALL_ARGS)
-    _check_one_line_error(rc, out, err, src, "normalisation failed")
+    _check_one_line_error(rc, out, err, src, "u: the input spectrum is zero on the fitted lines")
 
 
 def test_unwritable_output_folder(small, tmp_path, capsys):

@@ -33,3 +33,25 @@ def test_readme_batch_example_runs(tmp_path, monkeypatch):
     for name in ("estimates.csv", "fits.csv", "summary.csv", "overview.csv"):
         assert (tmp_path / "study" / name).exists()
     assert list(table.record) == [f"machine {s}" for s in range(1, 5)] and table.ok.all()
+
+
+def test_readme_several_experiments_example_runs(tmp_path, monkeypatch):
+    """Two records of the paper's model fitted together: against the truth and the CRB of both."""
+    import numpy as np
+
+    import lptv
+    from lptv.examples import paper_model
+
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
+              if "records.append(" in b]
+    assert len(blocks) == 1
+    monkeypatch.chdir(tmp_path)
+    ns = {}
+    exec(compile(blocks[0], "README.md", "exec"), ns)
+    res = ns["res"]
+    assert res.n_experiments == 2 and np.array_equal(np.bincount(res.experiment), [243, 243])
+    assert res.converged and res.model_ok
+    # Every parameter within 4.5 of its reported std of the truth (34 parameters, one seed).
+    truth = lptv.crb(paper_model(), lptv.multisine(range(10, 121, 10), 2048), var_y=1.0).eta
+    free = res.parameter_std > 0
+    assert np.all(np.abs(res.eta - truth)[free] <= 4.5 * res.parameter_std[free])

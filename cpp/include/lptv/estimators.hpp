@@ -59,6 +59,13 @@ GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ);
 
 EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
                         const EstimateOptions& opt = EstimateOptions());
+// Several independent experiments on the same system (same w0 and time domain), each with its
+// own rows (METHOD.md section 14): rows stacked, column covariances summed, WGTLS weights per
+// row from its own experiment, the exact likelihood's S block diagonal over experiments.
+// One experiment gives exactly the single-experiment estimate.
+EstimateResult estimate(const std::vector<FrequencyData>& experiments, const Parametrisation& p,
+                        const std::vector<std::vector<int>>& rows,
+                        const EstimateOptions& opt = EstimateOptions());
 
 // Fraction of normalised residues above 0 dB expected for a correct model, and a band of
 // +-3 binomial standard deviations over the rows (METHOD.md section 7).
@@ -76,6 +83,9 @@ struct IdentifyOptions {
   double tol = 1e-10;
   int max_iter = 50;
   std::vector<int> rows;    // lines of the fit; empty: default_rows
+  // Several experiments: the rows of each (empty, or an empty entry: that experiment's
+  // default_rows). With one experiment, `rows` may be used instead.
+  std::vector<std::vector<int>> experiment_rows;
   bool covariance = true;   // WGTLS, SML: compute the covariance of eta
 };
 
@@ -83,7 +93,9 @@ struct Identification {
   explicit Identification(Model m) : model(std::move(m)) {}
   Model model;                        // normalised: a_{na,0} = 1 (or scaled by known coefficients)
   Method method = Method::WGTLS;
-  std::vector<int> rows;
+  std::vector<int> rows;              // the rows of every experiment, one after the other
+  std::vector<int> experiment;        // per row: the index of its experiment (all 0 for one)
+  int n_experiments = 1;
   Eigen::VectorXcd theta;
   Eigen::VectorXd eta;
   std::vector<std::string> eta_names;
@@ -100,14 +112,22 @@ struct Identification {
   ExpectedFraction fraction_expected{0, 0, 0};
   bool residue_ok = false;            // fraction_above_0db inside the expected band
   bool nearly_unidentifiable = false; // the two smallest generalised singular values are close
+                                      // (LS, TLS: those of the GTLS problem on the same rows)
   bool noise_free = false;
   // WGTLS (sandwich) and SML (inverse Fisher information), times covariance_correction(P):
-  // n_eta x n_eta, zero row and column for the normalised parameter; empty otherwise.
+  // n_eta x n_eta, zero row and column for the normalised parameter; empty otherwise. With
+  // experiments of different P, each experiment's term of the sandwich carries its own factor
+  // (METHOD.md section 14).
   Eigen::MatrixXd covariance;
   std::vector<std::string> warnings;
 };
 
 // Estimate, covariance and residue diagnostics of every method on the data (METHOD.md 5-7, 10).
 Identification identify(const FrequencyData& d, const Structure& s, const IdentifyOptions& opt = IdentifyOptions());
+// Several experiments of the same system (same w0, same time domain: the caller's structure)
+// fitted together into one model (METHOD.md section 14); rows per experiment from
+// opt.experiment_rows. The result's rows, residues and `experiment` run over all experiments.
+Identification identify(const std::vector<FrequencyData>& experiments, const Structure& s,
+                        const IdentifyOptions& opt = IdentifyOptions());
 
 }  // namespace lptv

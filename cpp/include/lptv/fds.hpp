@@ -54,8 +54,17 @@ class Fds {
   // changes of the model's coefficients: max_i |(A^-1 b)_i| with |b_i| the sum over row i
   // of |a_{n,k}| |s_j|^n. A value c costs about log10(c) of the 16 digits.
   double condition() const { return condition_; }
+  // The line where that maximum is reached.
+  int condition_line() const { return condition_line_; }
   // Above this the FDS refuses to solve (NumericalError): fewer than 3 digits would be left.
   static constexpr double kMaxCondition = 1e13;
+  // Above this simulate's result carries a warning (SimulateResult::condition; Python warns
+  // with lptv.ConditioningWarning): more than half of the 16 digits lost (1 / sqrt(eps) =
+  // 6.7e7, rounded up), i.e. a pole within a relative distance of about 1e-8 of the line, so
+  // the output there is amplified about that much and is as sensitive to the coefficients
+  // (damping 1e-12 on an oscillator's line: condition 2e12, an output of 1e12 times the input
+  // that a coefficient change of 1e-12 moves by its own size).
+  static constexpr double kWarnCondition = 1e8;
   // Full-grid input spectra (grid.N rows, any number of columns) -> output spectra.
   Eigen::MatrixXcd solve_full(const Eigen::MatrixXcd& U) const;
   // Columns of the harmonic transfer function G = A^-1 B for the given input lines.
@@ -69,6 +78,7 @@ class Fds {
   std::unique_ptr<BandLU> band_;        // the band solver above (LAPACK)
   std::unique_ptr<SparseLU> lu_;
   double condition_ = 0.0;
+  int condition_line_ = 0;
   Eigen::MatrixXcd solve_A(const Eigen::MatrixXcd& rhs) const;
 };
 
@@ -83,6 +93,7 @@ struct GridSolution {
   Grid grid;
   Eigen::MatrixXcd Y;
   double condition = 0.0;  // as Fds::condition()
+  int condition_line = 0;  // as Fds::condition_line()
   Solver solver = Solver::Auto;
 };
 GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full,
@@ -108,6 +119,12 @@ struct SimulateResult {
   double truncation_error = 0;   // estimated relative error from the truncation
   bool converged = true;         // adaptive guard reached tol
   Solver solver = Solver::Auto;  // backend actually used
+  // Fds::condition of the last grid and the line (>= 0) where it peaks. An LTI model's lines do
+  // not couple, so there it is the largest sum_n |a_n| |s_l|^n / |a(s_l)| over the lines with
+  // input only (a pole next to a line without input leaves the output untouched). Above
+  // Fds::kWarnCondition the result has lost more than half of its digits.
+  double condition = 0.0;
+  int condition_line = 0;
 };
 
 // The decay per line the model predicts for its output beyond the excited lines, far from

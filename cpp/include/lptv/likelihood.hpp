@@ -24,6 +24,10 @@ namespace lptv {
 class ExactLikelihood {
  public:
   ExactLikelihood(const FrequencyData& d, const Parametrisation& p, std::vector<int> rows);
+  // One experiment of several fitted together (METHOD.md section 14): the rows are checked
+  // line by line only, since the equations are counted over all experiments.
+  struct PartOfSeveral {};
+  ExactLikelihood(const FrequencyData& d, const Parametrisation& p, std::vector<int> rows, PartOfSeveral);
 
   struct Evaluation {
     double cost = 0;             // V = r^T S^{-1} r
@@ -47,6 +51,12 @@ class ExactLikelihood {
   // is J^T W (M x) = 0 with the real row weights W = diag(w_l, w_l): H^{-1} J^T W S W J H^{-1},
   // H = J^T W J, J = dr/dxi at x0 (the weighted GTLS of eq. 14 to first order in the noise).
   Eigen::MatrixXd sandwich_covariance(const Eigen::VectorXcd& theta, const Eigen::VectorXd& weights) const;
+  // Its two terms, H = J^T W J (bread) and J^T W S W J (meat): experiments are independent, so
+  // both add over the experiments of a joint fit.
+  struct SandwichTerms {
+    Eigen::MatrixXd bread, meat;
+  };
+  SandwichTerms sandwich_terms(const Eigen::VectorXcd& theta, const Eigen::VectorXd& weights) const;
 
   // S in dense form, sorted-row order (for tests and small problems).
   Eigen::MatrixXd residue_covariance(const Eigen::VectorXcd& theta) const;
@@ -58,6 +68,7 @@ class ExactLikelihood {
 
  private:
   struct Factor;  // the banded Cholesky factor of S and the per-entry blocks
+  void init(const std::vector<int>& rows);  // sorted rows and bandwidth, after the checks
   Factor factor(const Eigen::VectorXcd& theta) const;
   // With whiten = false: cost, w and x0, and the Jacobian at x0 not whitened (no gradient).
   Evaluation evaluate(const Factor& f, bool whiten) const;
@@ -83,12 +94,22 @@ struct ExactFit {
 };
 ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
                              const Eigen::VectorXcd& theta0, double tol, int max_iter);
+// Several independent experiments (METHOD.md section 14): S is block diagonal over them, so V,
+// its gradient and the Gauss-Newton information are the sums of the experiments' own.
+ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
+                             const Eigen::VectorXcd& theta0, double tol, int max_iter);
+
+// H^{-1} meat H^{-1} (symmetrised); NumericalError when H is singular.
+Eigen::MatrixXd sandwich_from_terms(const Eigen::MatrixXd& bread, const Eigen::MatrixXd& meat);
 
 // The Cramer-Rao bound of eta for a design: `noiseless` holds the true spectra U, Y and the
 // true (co)variances of the noise on them; theta the true parameters. n_eta x n_eta, zero row
 // and column for the normalised parameter.
 Eigen::MatrixXd cramer_rao_bound(const FrequencyData& noiseless, const Parametrisation& p,
                                  const std::vector<int>& rows, const Eigen::VectorXcd& theta);
+// The bound of several independent experiments: their Fisher informations add.
+Eigen::MatrixXd cramer_rao_bound(const std::vector<FrequencyData>& noiseless, const Parametrisation& p,
+                                 const std::vector<std::vector<int>>& rows, const Eigen::VectorXcd& theta);
 
 // A covariance of the free entries of xi (free_indices order) placed into eta coordinates:
 // n_eta x n_eta, zero row and column for the normalised parameter.

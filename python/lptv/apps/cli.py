@@ -4,6 +4,7 @@
     lptv demo lecture [--out DIR] [--quick]               the lecture's cases
     lptv identify FILE --na 2 --nb 1 ...                  a model from your own measurements
     lptv identify FILES... [--workers N | --scheduler ADDRESS]   many files, one row each
+    lptv identify FILES... --joint --na 2 --nb 1 ...       records of one system, one model
     lptv select FILE --na 1-3 --nb 0-2 [--k 0-4]          choose the orders and harmonic count
     lptv montecarlo --runs R --periods P --method wgtls,sml [--scheduler ADDRESS]
                                                           a Monte Carlo study of the estimators

@@ -1,7 +1,8 @@
 """``lptv identify FILE``: an LPTV model from your own periodic measurements.
 
 (Several files, ``lptv identify FILES... [--workers N | --scheduler ADDRESS]``, are fitted as a
-batch by :mod:`lptv.apps.manyid`.)
+batch by :mod:`lptv.apps.manyid`; with ``--joint`` they are records of one system fitted into one
+model by :mod:`lptv.apps.jointid`.)
 
 The file holds P >= 2 steady-state periods of the input u and the output y:
 
@@ -98,7 +99,7 @@ def positive(value, opt):
     return value
 
 
-def _fundamental(args, meas):
+def fundamental(args, meas):
     """w0 from --w0 / --period, the file, and (discrete time) --ts with the samples per period."""
     w0 = positive(args.w0, "--w0")
     if positive(args.period, "--period") is not None:
@@ -131,7 +132,8 @@ Identify an LPTV model from P >= 2 measured steady-state periods of input u and 
   .mat  MATLAB v5 or v7.3: variables u, y of size P x N; optional scalar w0
 Writes model.json, report.html and summary.json, and prints the validation verdict.
 Several files (or --workers / --scheduler) make a batch: one row per file in results.csv,
-each model in models/, the fits on local processes or a Dask cluster."""
+each model in models/, the fits on local processes or a Dask cluster. With --joint the files
+are records of one system (same period) fitted together into one model and one report."""
 
 
 def add_parser(sub):
@@ -142,7 +144,8 @@ def add_parser(sub):
                "  lptv identify record.csv --fs 100 --period 10 --na 2 --nb 0 --method sml\n"
                "  lptv identify record.csv --fs 100 --period 10 --trim --skip-periods 1 --na 2 --nb 0\n"
                "  lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
-               "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2")
+               "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2\n"
+               "  lptv identify low.npz high.npz --joint --na 2 --nb 1 --method sml")
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurements: .csv, .npz or .mat; several files are fitted as a batch")
     p.add_argument("--na", type=int, required=True, help="order of the output side")
@@ -175,6 +178,9 @@ def add_parser(sub):
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
     p.add_argument("--tol", type=float, default=1e-10, help="WGTLS relative tolerance (default 1e-10)")
     b = p.add_mutually_exclusive_group()
+    b.add_argument("--joint", action="store_true",
+                   help="several files: records of ONE system (same period; own multisine, P and N each) "
+                        "fitted together into one model and one report, instead of one fit per file")
     b.add_argument("--workers", type=int, metavar="N",
                    help="batch: fit the files on N local processes (default: all cores; 1: serially)")
     b.add_argument("--scheduler", metavar="ADDRESS",
@@ -195,6 +201,10 @@ def _fail(name, problem) -> int:
 # ------------------------------------------------------------------------------ running
 
 def run(args) -> int:
+    if args.joint:
+        from lptv.apps import jointid
+
+        return jointid.run(args)
     if len(args.files) > 1 or args.workers is not None or args.scheduler is not None:
         from lptv.apps import manyid
 
@@ -220,14 +230,14 @@ def run(args) -> int:
         ts = 1.0 / meas.fs if args.discrete else args.ts
         if args.discrete:
             args.ts = ts
-        w0 = _fundamental(args, meas)
+        w0 = fundamental(args, meas)
         record = check_record(meas.u, meas.y, warn=False)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
                            max_iter=args.max_iter)
-            Y_pred = simulate(res.model, res.data.U)
+            Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
@@ -280,6 +290,7 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "prediction_error_vs_noise_db": _prediction_gap_db(res, Y_pred),
         "fs": meas.fs, "trimmed_samples": meas.trimmed, "skipped_periods": meas.skipped,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
+        "undetermined": res.undetermined,
         "n_verdict_lines": int(res.verdict_lines.size), "verdict_fraction_above_0db": res.verdict_fraction,
         "verdict_band": list(res.verdict_band),
         "parameters": parameter_table(res),

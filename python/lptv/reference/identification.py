@@ -36,7 +36,7 @@ __all__ = [
     "Data", "frequency_data", "Parametrisation", "default_rows", "line_values", "line_noise",
     "line_variable", "jacobian", "residue", "band_rows", "residue_variance", "column_covariance",
     "real_column_covariance", "real_jacobian", "solve_ls", "solve_tls", "solve_gtls", "estimate",
-    "normalized_residue", "expected_fraction_above_0db", "theta_of_coefficients",
+    "normalized_residue", "expected_fraction_above_0db", "theta_of_coefficients", "estimate_experiments",
 ]
 
 # Relative floor of the residue variance when it becomes the WGTLS weight (as in the core):
@@ -368,7 +368,21 @@ def estimate(data: Data, par: Parametrisation, rows, method: str = "wgtls", tol:
     VARIANCE_FLOOR * max var e), GTLS on the weighted Jacobian with CJ_W built with the same w,
     until ||theta_new - theta|| / ||theta_new|| < tol or max_iter weighted solves.
     """
-    rows = np.asarray(rows)
+    return estimate_experiments([data], par, [rows], method, tol, max_iter)
+
+
+def estimate_experiments(datas: Sequence[Data], par: Parametrisation, rows_list, method: str = "wgtls",
+                         tol: float = 1e-10, max_iter: int = 50) -> dict:
+    """:func:`estimate` on several independent experiments of one system (METHOD.md section 14).
+
+    Experiment e contributes its own rows, built from its own spectra: the real Jacobian is the
+    experiments' Jacobians one above the other, CJ_W the sum of their column covariances (the
+    noise of different experiments is independent, so the expectations add), and each row's
+    WGTLS weight 1 / var e_l comes from its own experiment's noise (the floor from the largest
+    variance over all rows).
+    """
+    rows_list = [np.asarray(r) for r in rows_list]
+    pairs = list(zip(datas, rows_list))
     out = dict(iterations=0, converged=True, cost_history=[], noise_free=False)
 
     def finish(solved):
@@ -376,7 +390,14 @@ def estimate(data: Data, par: Parametrisation, rows, method: str = "wgtls", tol:
         out.update(theta=par.theta_from_xi(x), eta=par.eta_from_xi(x), singular_values=values,
                    cost=cost)
 
-    Jx = real_jacobian(data, par, rows)
+    def stacked_jacobian(weights=None):
+        return np.vstack([real_jacobian(d, par, r, None if weights is None else w)
+                          for (d, r), w in zip(pairs, weights or [None] * len(pairs))])
+
+    def summed_cj(weights):
+        return sum(real_column_covariance(d, par, r, w) for (d, r), w in zip(pairs, weights))
+
+    Jx = stacked_jacobian()
     if method == "ls":
         finish(solve_ls(Jx, par.norm_index))
         return out
@@ -385,7 +406,7 @@ def estimate(data: Data, par: Parametrisation, rows, method: str = "wgtls", tol:
         return out
     if method not in ("gtls", "wgtls"):
         raise ValueError(f"unknown method {method!r}")
-    CJ = real_column_covariance(data, par, rows, np.ones(rows.size))
+    CJ = summed_cj([np.ones(r.size) for r in rows_list])
     if np.max(np.abs(CJ)) == 0.0:
         # No noise: no weight to apply; TLS is exact on noise-free data.
         out["noise_free"] = True
@@ -396,14 +417,14 @@ def estimate(data: Data, par: Parametrisation, rows, method: str = "wgtls", tol:
         return out
     out["converged"] = False
     for it in range(1, max_iter + 1):
-        v = residue_variance(data, par, rows, out["theta"])
-        if not (np.all(np.isfinite(v)) and v.max() > 0):
+        v = [residue_variance(d, par, r, out["theta"]) for d, r in pairs]
+        vmax = max(x.max() for x in v)
+        if not (all(np.all(np.isfinite(x)) for x in v) and vmax > 0):
             raise np.linalg.LinAlgError(
                 f"WGTLS: the residue variance is not positive at iteration {it}")
-        w = 1.0 / np.maximum(v, VARIANCE_FLOOR * v.max())
+        w = [1.0 / np.maximum(x, VARIANCE_FLOOR * vmax) for x in v]
         prev = out["theta"]
-        finish(solve_gtls(real_jacobian(data, par, rows, w),
-                          real_column_covariance(data, par, rows, w)))
+        finish(solve_gtls(stacked_jacobian(w), summed_cj(w)))
         out["iterations"] = it
         out["cost_history"].append(out["cost"])
         if np.linalg.norm(out["theta"] - prev) / np.linalg.norm(out["theta"]) < tol:

@@ -28,6 +28,7 @@ from .identification import Data, Parametrisation, band_rows
 __all__ = [
     "noise_vector_covariance", "data_vector", "residue_map", "residue_covariance", "exact_cost",
     "exact_cost_gradient", "fisher_information", "crb", "sml_estimate", "xi_of_theta",
+    "crb_experiments", "sml_estimate_experiments", "sandwich_terms", "exact_cost_experiments", "denoised",
 ]
 
 
@@ -166,10 +167,21 @@ def fisher_information(data: Data, par: Parametrisation, rows, theta) -> np.ndar
 def crb(data: Data, par: Parametrisation, rows, theta) -> np.ndarray:
     """Covariance bound of eta (n_eta x n_eta): F^-1 on the free entries; the normalised
     parameter (when nothing is known) gets a zero row and column."""
-    F = fisher_information(data, par, rows, theta)
+    return _eta_covariance(par, np.linalg.inv(fisher_information(data, par, rows, theta)))
+
+
+def crb_experiments(datas, par: Parametrisation, rows_list, theta) -> np.ndarray:
+    """The bound of several independent experiments (METHOD.md section 14): the noise vector is
+    the experiments' noise vectors one after the other, so Cov(n) and S are block diagonal and
+    F = J^T S^-1 J is the sum of the experiments' informations."""
+    F = sum(fisher_information(d, par, r, theta) for d, r in zip(datas, rows_list))
+    return _eta_covariance(par, np.linalg.inv(F))
+
+
+def _eta_covariance(par: Parametrisation, cov_free) -> np.ndarray:
     free = _free(par)
     cov = np.zeros((par.n_xi, par.n_xi))
-    cov[np.ix_(free, free)] = np.linalg.inv(F)
+    cov[np.ix_(free, free)] = cov_free
     # With a known part, xi = [eta, 1]: the last (known) column is the normalised one.
     return cov[:par.n_eta, :par.n_eta]
 
@@ -185,6 +197,46 @@ def xi_of_theta(par: Parametrisation, theta) -> np.ndarray:
 
 def sml_estimate(data: Data, par: Parametrisation, rows, theta0, *, tol: float = 1e-13,
                  max_iter: int = 100) -> dict:
+    """Minimise V (eq. 17) over the free entries of xi, xi[norm_index] = 1, from theta0: see
+    :func:`sml_estimate_experiments`, here with one experiment."""
+    return sml_estimate_experiments([data], par, [rows], theta0, tol=tol, max_iter=max_iter)
+
+
+def exact_cost_experiments(datas, par: Parametrisation, rows_list, theta) -> float:
+    """V of several independent experiments: S block diagonal, so the costs add."""
+    return float(sum(exact_cost(d, par, r, theta) for d, r in zip(datas, rows_list)))
+
+
+def denoised(data: Data, par: Parametrisation, rows, theta) -> Data:
+    """The data nearest to the measured ones in the noise metric that the model explains exactly:
+    x0 = x - Cov(n) M^T S^-1 r (the noiseless spectra the likelihood eliminates), with the same
+    (co)variances. ``fisher_information(denoised(...))`` is the information at the estimate."""
+    rows = np.asarray(rows)
+    M = residue_map(data, par, rows, theta)
+    C = noise_vector_covariance(data)
+    S = residue_covariance(data, par, rows, theta)
+    x = data_vector(data)
+    x0 = (x - C @ M.T @ np.linalg.solve(S, M @ x)).reshape(-1, 4)
+    return Data(U=x0[:, 2] + 1j * x0[:, 3], Y=x0[:, 0] + 1j * x0[:, 1], varU=data.varU,
+                varY=data.varY, covYU=data.covYU, periods=data.periods)
+
+
+def sandwich_terms(data: Data, par: Parametrisation, rows, theta, weights):
+    """The two terms of the WGTLS covariance (first order in the noise), densely: with J the real
+    Jacobian dr/dxi (free entries) evaluated at the data x0 = x - Cov(n) M^T S^-1 r that the model
+    explains exactly, and W = diag(w_l, w_l) per row, H = J^T W J and the meat J^T W S W J.
+    Over independent experiments both add; the covariance is H^-1 meat H^-1."""
+    rows = np.asarray(rows)
+    S = residue_covariance(data, par, rows, theta)
+    x0 = data_vector(denoised(data, par, rows, theta))
+    J = np.column_stack([residue_map(data, par, rows, par.Text[:, j]) @ x0 for j in _free(par)])
+    W = np.repeat(np.asarray(weights, float), 2)
+    WJ = W[:, None] * J
+    return J.T @ WJ, WJ.T @ S @ WJ
+
+
+def sml_estimate_experiments(datas, par: Parametrisation, rows_list, theta0, *, tol: float = 1e-13,
+                             max_iter: int = 100) -> dict:
     """Minimise V (eq. 17) over the free entries of xi, xi[norm_index] = 1, from theta0.
 
     Newton's method: the exact gradient above and a Hessian from its central differences
@@ -204,15 +256,20 @@ def sml_estimate(data: Data, par: Parametrisation, rows, theta0, *, tol: float =
     differences are rounding noise, so a step that raises V by no more than 100 eps |V| is
     still taken.
     """
-    rows = np.asarray(rows)
     norm, free = par.norm_index, _free(par)
-    C, x = noise_vector_covariance(data), data_vector(data)
-    dM = _basis_maps(data, par, rows)
+    # Per experiment: Cov(n), x and the basis maps. S is block diagonal over the experiments
+    # (independent noise), so V and its gradient are the sums of the experiments' own.
+    parts = [(noise_vector_covariance(d), data_vector(d), _basis_maps(d, par, np.asarray(r)))
+             for d, r in zip(datas, rows_list)]
     xi = xi_of_theta(par, theta0)
     xi = xi / xi[norm]
 
     def evaluate(z):
-        return _cost_and_gradient(np.tensordot(z, dM, axes=1), dM, C, x)
+        V, g = 0.0, 0.0
+        for C, x, dM in parts:
+            Ve, ge = _cost_and_gradient(np.tensordot(z, dM, axes=1), dM, C, x)
+            V, g = V + Ve, g + ge
+        return V, g
 
     def hessian(z):
         H = np.empty((free.size, free.size))
