@@ -1,6 +1,8 @@
 // FDS cost per line from 10^3 to 10^7 lines: the band LU (lptv::SmallBandLU, the
 // continuous-time default) against KLU and UMFPACK, with peak memory; the one-pass route of
-// lptv::simulate (lptv::solve_grid) against a memory copy of the bytes it must move.
+// lptv::simulate (lptv::solve_grid) against a memory copy of the bytes it must move, for a
+// general full-grid input and for a real one (conjugate-symmetric, what simulate passes: the
+// half-grid route).
 //
 // The paper-like model (7 diagonals in A and B) on a fixed grid -L..L with n = 2L+1 lines and
 // one random full-grid input: lptv::Fds (build A, factorise it, check its conditioning with one
@@ -53,6 +55,9 @@ struct Measurement {
   // per line from one warm array to another (STREAM's copy: the bytes read plus those written
   // equal the bytes the one-pass route must move at least, see kFloorBytes).
   double fused = -1, copy = -1, fused_diff = 0;
+  // The same route for a real input (U_{-l} = conj(U_l), as simulate passes it): the half-grid
+  // route (cpp/src/fds_fold.hpp); its difference from Fds::solve_full on that input.
+  double real = -1, real_diff = 0;
   long rss_base_kb = 0, rss_peak_kb = 0;
   double residual = 0;   // |A Y - B U| / (|A| |Y| + |B U|), max norms
   double condition = 0;  // Fds::condition()
@@ -182,6 +187,12 @@ Measurement measure(const lptv::Model& model, int L, Route route) {
     Eigen::MatrixXcd Yf;
     repeat([&] { timed(&m.fused, [&] { Yf = lptv::solve_grid(model, L, U, lptv::Solver::Band).Y; }); });
     m.fused_diff = (Yf - Y).cwiseAbs().maxCoeff() / Y.cwiseAbs().maxCoeff();
+    Eigen::MatrixXcd Ur(g.N, 1);
+    for (int l = 0; l <= L; ++l) Ur(L + l, 0) = U(L + l, 0), Ur(L - l, 0) = std::conj(U(L + l, 0));
+    Ur(L, 0) = U(L, 0).real();
+    const Eigen::MatrixXcd Yr_ref = lptv::Fds(model, L, lptv::Solver::Band).solve_full(Ur);
+    repeat([&] { timed(&m.real, [&] { Yf = lptv::solve_grid(model, L, Ur, lptv::Solver::Band).Y; }); });
+    m.real_diff = (Yf - Yr_ref).cwiseAbs().maxCoeff() / Yr_ref.cwiseAbs().maxCoeff();
     const size_t bytes = static_cast<size_t>(kFloorBytes) * g.N / 2;
     std::vector<char> src(bytes, 1), dst(bytes, 0);
     repeat([&] { timed(&m.copy, [&] { std::memcpy(dst.data(), src.data(), bytes); }); });
@@ -248,6 +259,7 @@ Measurement merge(const Measurement& a, const Measurement& b) {
   m.part1 = fastest(a.part1, b.part1);
   m.part2 = fastest(a.part2, b.part2);
   m.fused = fastest(a.fused, b.fused);
+  m.real = fastest(a.real, b.real);
   m.copy = fastest(a.copy, b.copy);
   m.rss_peak_kb = std::max(a.rss_peak_kb - a.rss_base_kb, b.rss_peak_kb - b.rss_base_kb);
   m.rss_base_kb = 0;
@@ -409,22 +421,32 @@ int main(int argc, char** argv) {
               "substitutions), ns per line,\nagainst a copy of %d bytes per line (memcpy between two "
               "warm arrays of %d bytes per line: the bytes the route must move at least)\n",
               kFloorBytes, kFloorBytes / 2);
-  std::printf("%10s %10s %10s %8s %10s\n", "lines", "one-pass", "copy", "ratio", "vs route");
-  double flo = 1e300, fhi = 0;
+  std::printf("(real input: U_{-l} = conj(U_l), as simulate passes it: the half-grid route, which "
+              "moves at least half those bytes, copy/2)\n");
+  std::printf("%10s %10s %10s %8s %10s | %10s %10s %8s %10s\n", "lines", "one-pass", "copy", "ratio",
+              "vs route", "real input", "copy/2", "ratio", "vs Fds");
+  double flo = 1e300, fhi = 0, rlo = 1e300, rhi = 0;
   for (const Row& r : rows) {
     const Measurement& m = r.m[kBand];
     if (!m.ok || m.fused < 0) continue;
     const double n = double(r.n);
-    std::printf("%10ld %10.1f %10.1f %8.2f %10.1e\n", r.n, 1e9 * m.fused / n, 1e9 * m.copy / n,
-                m.fused / m.copy, m.fused_diff);
+    std::printf("%10ld %10.1f %10.1f %8.2f %10.1e | %10.1f %10.1f %8.2f %10.1e\n", r.n,
+                1e9 * m.fused / n, 1e9 * m.copy / n, m.fused / m.copy, m.fused_diff, 1e9 * m.real / n,
+                0.5e9 * m.copy / n, m.real / (0.5 * m.copy), m.real_diff);
     flo = std::min(flo, m.fused / n);
     fhi = std::max(fhi, m.fused / n);
+    rlo = std::min(rlo, m.real / n);
+    rhi = std::max(rhi, m.real / n);
+    if (!(m.real_diff <= 1e-12)) {
+      std::fprintf(stderr, "the real-input route disagrees with Fds at n = %ld: %.1e\n", r.n, m.real_diff);
+      failed = true;
+    }
     if (!(m.fused_diff <= 1e-12)) {
       std::fprintf(stderr, "solve_grid disagrees with Fds at n = %ld: %.1e\n", r.n, m.fused_diff);
       failed = true;
     }
   }
-  if (fhi > 0) std::printf("one-pass spread (max / min): %.2fx\n", fhi / flo);
+  if (fhi > 0) std::printf("one-pass spread (max / min): %.2fx, real input %.2fx\n", fhi / flo, rhi / rlo);
 
   std::printf("\nspread of the time per line (max / min over the sizes that ran; goal: within 2x "
               "from 10^3 to 10^7):");

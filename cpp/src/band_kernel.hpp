@@ -44,9 +44,16 @@ inline kcd cmsub(kcd a, kcd l, kcd u) {
   return {a.real() - (l.real() * u.real() - l.imag() * u.imag()),
           a.imag() - (l.real() * u.imag() + l.imag() * u.real())};
 }
-// 1 / p by Smith's method (no overflow of |p|^2).
+// 1 / p: conj(p) / |p|^2, one division on the elimination's critical path (each step's
+// multipliers wait for it); Smith's method (two divisions) where |p|^2 could overflow or lose
+// bits to underflow.
 inline kcd crecip(kcd p) {
   const double a = p.real(), b = p.imag();
+  const double m = std::max(std::abs(a), std::abs(b));
+  if (m > 1e-150 && m < 1e150) {
+    const double id = 1.0 / (a * a + b * b);
+    return {a * id, -b * id};
+  }
   if (std::abs(a) >= std::abs(b)) {
     const double r = b / a, id = 1.0 / (a + b * r);
     return {id, -r * id};
@@ -108,21 +115,35 @@ struct ZeroPivot {
   int column;
 };
 
+// What a partial factorisation leaves (factor_band with steps < n): the K rows of the window
+// at step `steps`, each as its 2K + 1 entries in columns steps..steps+2K (the last one zero),
+// and their nz eliminated right-hand sides; rows steps+K.. have not entered.
+struct BandTail {
+  std::vector<kcd> rows, z;
+};
+
 // Factorises the n x n band matrix given by src, eliminating nz right-hand sides on the way.
 // Source:  void row(int r, int base, kcd* out): out[j] = A(r, base + j), j = 0..2K (zero
 //          outside the band and the matrix);  void rhs(int r, kcd* z): the nz right-hand sides
 //          of row r.
 // z: (n + 2K) x nz, row-major: rows 0..n-1 receive the forward-eliminated right-hand sides,
 // the 2K rows below are set to zero (back_substitute reads past the last row).
+// With 0 < steps < n - K and a tail, only the first `steps` columns are eliminated (rows up
+// to steps + K - 1 enter): f holds `steps` rows of U, z rows 0..steps-1, the window goes to
+// *tail, and z's rows steps..steps+2K-1 are left to the caller (the solution of the rest,
+// which back_substitute then reads).
 template <int KT, class Source>
-void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_L, kcd* z) {
+void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_L, kcd* z,
+                 int steps = -1, BandTail* tail = nullptr) {
   const int K = KT >= 0 ? KT : Krt;
   const int W = 2 * K + 1;
-  f.n = n;
+  const bool partial = tail && steps >= 0 && steps < n;
+  if (!partial) steps = n;
+  f.n = steps;
   f.K = K;
-  f.U.resize(static_cast<size_t>(n) * W);
-  f.piv.resize(n);
-  f.L.resize(keep_L ? static_cast<size_t>(n) * std::max(K, 1) : 0);
+  f.U.resize(static_cast<size_t>(steps) * W);
+  f.piv.resize(steps);
+  f.L.resize(keep_L ? static_cast<size_t>(steps) * std::max(K, 1) : 0);
   std::vector<kcd> win(static_cast<size_t>(K + 1) * W), zw(static_cast<size_t>(K + 1) * std::max(nz, 1));
   // Position i of the window at step k lives in slot (k + i) mod (K + 1): the row that leaves
   // frees the slot of the row that enters next. A pivot swap exchanges the two rows' contents
@@ -135,7 +156,7 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
     if (nz) src.rhs(r, zrow(r));
   }
   int s0 = 0;  // slot of position 0 at step k, k mod (K + 1)
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < steps; ++k) {
     auto slot = [&](int i) { return s0 + i <= K ? s0 + i : s0 + i - (K + 1); };
     if (k + K < n) {
       src.row(k + K, k, wrow(slot(K)));
@@ -176,6 +197,16 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
       for (int i = m + 1; i <= K; ++i) f.L[static_cast<size_t>(k) * K + (i - 1)] = kcd(0.0, 0.0);
     s0 = s0 == K ? 0 : s0 + 1;
   }
+  if (partial) {
+    tail->rows.resize(static_cast<size_t>(K) * W);
+    tail->z.resize(static_cast<size_t>(K) * nz);
+    for (int i = 0; i < K; ++i) {
+      const int s = s0 + i <= K ? s0 + i : s0 + i - (K + 1);
+      std::copy(wrow(s), wrow(s) + W, &tail->rows[static_cast<size_t>(i) * W]);
+      std::copy(zrow(s), zrow(s) + nz, &tail->z[static_cast<size_t>(i) * nz]);
+    }
+    return;
+  }
   std::fill(z + static_cast<size_t>(n) * nz, z + static_cast<size_t>(n + 2 * K) * nz, kcd(0.0, 0.0));
 }
 
@@ -188,8 +219,10 @@ void back_substitute(const BandFactors& f, int nz, kcd* z) {
     const kcd* Uk = &f.U[static_cast<size_t>(k) * W];
     kcd* zk = z + static_cast<size_t>(k) * nz;
     for (int c = 0; c < nz; ++c) {
+      // The farthest term first: z_{k+1}, which the step before has just written, comes last,
+      // so one product and one subtraction separate the steps instead of 2K of them.
       kcd s = zk[c];
-      for (int j = 1; j < W; ++j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
+      for (int j = W - 1; j >= 1; --j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
       zk[c] = cmul(s, Uk[0]);
     }
   }

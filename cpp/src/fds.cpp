@@ -6,9 +6,11 @@
 #include <functional>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "band_kernel.hpp"
 #include "band_row.hpp"
+#include "fds_fold.hpp"
 #include "lptv/errors.hpp"
 
 namespace lptv {
@@ -121,7 +123,7 @@ Eigen::MatrixXcd apply_B(const Model& m, const Grid& g, const Eigen::MatrixXcd& 
 
 namespace {
 
-constexpr double kGoldenAngle = 2.399963229728653;
+constexpr double kGoldenAngle = detail::kCheckPhaseStep;
 
 // The conditioning check's right-hand side (see Fds::condition): row i's magnitude of terms,
 // sum over its entries of sum_n |a_{n,k}| |s_j|^n, times the unit phase exp(j g i) of the
@@ -157,19 +159,21 @@ void check_condition(double condition, int where, const std::function<std::strin
 }
 
 // The rows of A of a continuous-time model on the grid -L..L for the small band kernel, built
-// from the band-row kernel (the same band_entry calls on the same powers as build_A and
-// band_storage_A, so the same bits), and the right-hand sides of each row: (B U)_r for the
-// columns of U (when given), then the conditioning check's entry (check_rhs, the phase by a
+// from the band-row kernel (band_entry_ct: the same numbers as build_A's and band_storage_A's
+// band_entry), and the right-hand sides of each row: (B U)_r for the columns of U (when given), then the conditioning check's entry (check_rhs, the phase by a
 // recurrence re-anchored every 256 rows).
 class ModelRows {
  public:
   ModelRows(const Model& m, const Grid& g, const Eigen::MatrixXcd* U)
       : m_(m), g_(g), U_(U), K_(m.ka()), Kb_(m.kb()), na_(m.na()), nb_(m.nb()),
-        P_(std::max(na_, nb_) + 1), absa_(m.a().cwiseAbs()) {
+        P_(std::max(na_, nb_) + 1), absa_(m.a().cwiseAbs()), aj_(m.a().rows(), m.a().cols()),
+        bj_(m.b().rows(), m.b().cols()) {
+    for (Eigen::Index k = 0; k < aj_.cols(); ++k) detail::times_j_powers(m.a().col(k).data(), na_, aj_.col(k).data());
+    for (Eigen::Index k = 0; k < bj_.cols(); ++k) detail::times_j_powers(m.b().col(k).data(), nb_, bj_.col(k).data());
     int R = 1;
     while (R < 2 * std::max(K_, Kb_) + 1) R *= 2;
     mask_ = R - 1;
-    pw_.resize(static_cast<size_t>(R) * P_);
+    t_.resize(static_cast<size_t>(R) * P_);
     wn_.resize(static_cast<size_t>(R) * (na_ + 1));
     nrhs_ = U ? static_cast<int>(U->cols()) : 0;
     if (U) {
@@ -183,25 +187,35 @@ class ModelRows {
   void row(int r, int base, cd* out) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
     const int lo = std::max(0, r - K_ - base), hi = std::min({2 * K_, r + K_ - base, g_.N - 1 - base});
-    const cd* a = m_.a().data();
     for (int j = 0; j < lo; ++j) out[j] = cd(0.0, 0.0);
-    for (int j = lo; j <= hi; ++j) {
-      const int c = base + j;
-      out[j] = detail::band_entry(a + static_cast<size_t>(K_ + r - c) * (na_ + 1), pw(c), na_);
+    // The order as a constant for the common ones, so that the sums unroll (the same sums).
+    switch (na_) {
+      case 1: entries(r, base, lo, hi, std::integral_constant<int, 1>(), out); break;
+      case 2: entries(r, base, lo, hi, std::integral_constant<int, 2>(), out); break;
+      case 3: entries(r, base, lo, hi, std::integral_constant<int, 3>(), out); break;
+      default: entries(r, base, lo, hi, na_, out); break;
     }
     for (int j = hi + 1; j <= 2 * K_; ++j) out[j] = cd(0.0, 0.0);
+  }
+  template <class Order>
+  void entries(int r, int base, int lo, int hi, Order na, cd* out) const {
+    const cd* a = aj_.data();
+    for (int j = lo; j <= hi; ++j) {
+      const int c = base + j;
+      out[j] = detail::band_entry_ct(a + static_cast<size_t>(K_ + r - c) * (na + 1), t(c), na);
+    }
   }
 
   void rhs(int r, cd* z) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
-    const cd* b = m_.b().data();
+    const cd* b = bj_.data();
     const int lo = std::max(0, r - Kb_), hi = std::min(g_.N - 1, r + Kb_);
     for (int q = 0; q < nrhs_; ++q) {
       const cd* u = U_->data() + static_cast<size_t>(q) * g_.N;
       double re = 0.0, im = 0.0;
       for (int c = lo; c <= hi; ++c) {
         if (!nonzero_[c]) continue;  // B U costs nothing on lines without input
-        const cd v = detail::band_entry(b + static_cast<size_t>(Kb_ + r - c) * (nb_ + 1), pw(c), nb_);
+        const cd v = detail::band_entry_ct(b + static_cast<size_t>(Kb_ + r - c) * (nb_ + 1), t(c), nb_);
         re += v.real() * u[c].real() - v.imag() * u[c].imag();
         im += v.real() * u[c].imag() + v.imag() * u[c].real();
       }
@@ -216,16 +230,17 @@ class ModelRows {
   }
 
  private:
-  const cd* pw(int c) const { return &pw_[static_cast<size_t>(c & mask_) * P_]; }
+  const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P_]; }
   const double* wn(int c) const { return &wn_[static_cast<size_t>(c & mask_) * (na_ + 1)]; }
   // Powers of the lines of the columns up to c (columns arrive in increasing order).
   void ensure(int c) {
     for (; next_ <= c; ++next_) {
-      const cd s = detail::line_variable(m_.w0(), m_.ts(), g_.line_of(next_));
-      detail::line_powers(s, P_ - 1, &pw_[static_cast<size_t>(next_ & mask_) * P_]);
-      // |s|: the line's |w| in continuous time, 1 up to rounding in discrete time (no hypot).
-      const double as = s.real() == 0.0 ? std::abs(s.imag()) : std::sqrt(std::norm(s));
-      detail::line_powers(as, na_, &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)]);
+      // s = j w, w = w0 l as line_variable forms it (continuous time: this source serves the
+      // band solver only); |s|^n = |w^n| (the same products).
+      double* t = &t_[static_cast<size_t>(next_ & mask_) * P_];
+      detail::real_powers(m_.w0() * g_.line_of(next_), P_ - 1, t);
+      double* wn = &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)];
+      for (int n = 0; n <= na_; ++n) wn[n] = std::abs(t[n]);
     }
   }
   const Model& m_;
@@ -233,11 +248,18 @@ class ModelRows {
   const Eigen::MatrixXcd* U_;
   int K_, Kb_, na_, nb_, P_, mask_ = 0, nrhs_ = 0, next_ = 0;
   Eigen::MatrixXd absa_;
-  std::vector<cd> pw_;
-  std::vector<double> wn_;
+  Eigen::MatrixXcd aj_, bj_;  // the coefficients times j^n (detail::times_j_powers)
+  std::vector<double> t_, wn_;
   std::vector<char> nonzero_;
   cd phase_{1.0, 0.0}, step_;
 };
+
+[[noreturn]] void zero_pivot(int column, const std::function<std::string(int)>& label) {
+  std::ostringstream msg;
+  msg << "A is singular at " << label(column)
+      << " (a zero pivot: the system has a pole on that line, or a_na(t) vanishes)";
+  throw NumericalError(msg.str());
+}
 
 // The small band kernel on the model's grid: factorises A with the right-hand sides of
 // ModelRows eliminated on the way, back-substitutes them, and returns the solutions of the U
@@ -261,10 +283,7 @@ FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXc
       detail::back_substitute<decltype(kt)::value>(f, nz, z.data());
     });
   } catch (const detail::ZeroPivot& e) {
-    std::ostringstream msg;
-    msg << "A is singular at " << label(e.column)
-        << " (a zero pivot: the system has a pole on that line, or a_na(t) vanishes)";
-    throw NumericalError(msg.str());
+    zero_pivot(e.column, label);
   }
   FusedSolve out;
   const int nu = nz - 1;
@@ -284,6 +303,21 @@ bool use_small_band(const Model& m) { return m.ka() <= SmallBandLU::kMaxK; }
 
 std::function<std::string(int)> line_label(const Grid& g) {
   return [g](int col) { return "line " + std::to_string(g.line_of(col)); };
+}
+
+// The half-grid route (fds_fold.hpp) for a real input given by its lines 0.., with the
+// refusals of the full-grid one.
+detail::FoldedSolution solve_half(const Model& m, const Grid& g, const detail::HalfInput& U) {
+  const auto label = line_label(g);
+  detail::FoldedSolution r;
+  try {
+    r = detail::solve_folded(m, g, U);
+  } catch (const detail::ZeroPivot& e) {
+    zero_pivot(e.column, label);
+  }
+  if (!r.Y.allFinite()) throw NumericalError("band solve produced NaN or inf");
+  check_condition(r.condition, r.where, label);
+  return r;
 }
 
 }  // namespace
@@ -332,6 +366,17 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
   }
   if (out.solver == Solver::Band && !out.grid.circular && use_small_band(m)) {
     const auto label = line_label(out.grid);
+    const int L = out.grid.L;
+    if (detail::can_fold(m, out.grid) && detail::real_input(out.grid, U_full)) {
+      // A real input: half the grid (fds_fold.hpp).
+      const detail::FoldedSolution r = solve_half(m, out.grid, U_full.middleRows(L, L + 1));
+      out.Y.resize(out.grid.N, r.Y.cols());
+      out.Y.middleRows(L, L + 1) = r.Y;
+      out.Y.topRows(L) = r.Y.bottomRows(L).colwise().reverse().conjugate();
+      out.condition = r.condition;
+      out.condition_line = out.grid.line_of(r.where);  // a line >= 0 (|x| is symmetric)
+      return out;
+    }
     detail::BandFactors f;
     FusedSolve r = fused_band_solve(m, out.grid, &U_full, f, false, label);
     check_condition(r.condition, r.where, label);
@@ -539,8 +584,27 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     double edge;  // outermost K lines relative to the peak
     double cond;
   };
+  // A real input (U_0 exactly real) on the band solver's grids: half the grid, from the
+  // one-sided U as it is (fds_fold.hpp).
+  const bool half = (opt.solver == Solver::Auto || opt.solver == Solver::Band) &&
+                    use_small_band(m) && U.row(0).imag().isZero(0.0);
   auto run = [&](int band_lines, int guard) {
     const Grid g = make_grid(m, band_lines + guard);
+    if (half && detail::can_fold(m, g)) {
+      const detail::FoldedSolution s =
+          solve_half(m, g, U.topRows(std::min<Eigen::Index>(U.rows(), g.L + 1)));
+      res.solver = Solver::Band;
+      const double peak = std::max(max_abs(s.Y), 1e-300);
+      double edge = 0;
+      for (int l = std::max(0, g.L - K + 1); l <= g.L; ++l) edge = std::max(edge, s.Y.row(l).cwiseAbs().maxCoeff());
+      const double cond = std::max(1.0, s.condition);
+      res.condition = s.condition;
+      res.condition_line = g.line_of(s.where);
+      Eigen::MatrixXcd out = Eigen::MatrixXcd::Zero(lines_out + 1, s.Y.cols());
+      const int top = std::min(lines_out, g.L);
+      out.topRows(top + 1) = s.Y.topRows(top + 1);
+      return Run{std::move(out), 10.0 * cond * edge / peak, edge / peak, cond};
+    }
     const GridSolution s = solve_grid(m, g.L, to_full(g, U), opt.solver);
     res.solver = s.solver;
     const Eigen::MatrixXcd& full = s.Y;

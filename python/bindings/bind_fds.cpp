@@ -18,7 +18,7 @@ py::dict simulate_py(const lptv::Model& model, const Eigen::MatrixXcd& U, const 
     r = lptv::simulate(model, U, opt);
   }
   py::dict d;
-  d["Y"] = r.Y;
+  d["Y"] = py::cast(std::move(r.Y));  // moved into the array's owner: no copy of the output
   d["guard"] = r.guard;
   d["truncation_error"] = r.truncation_error;
   d["converged"] = r.converged;

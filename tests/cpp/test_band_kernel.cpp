@@ -176,6 +176,115 @@ TEST_CASE("FDS band kernel equals LAPACK's band LU and KLU for every bandwidth",
   }
 }
 
+namespace {
+
+// Full-grid columns of a real input: U_{-l} = conj(U_l), U_0 real (as simulate builds them).
+Eigen::MatrixXcd real_input(int L, int ncol, unsigned seed) {
+  const Eigen::MatrixXcd h = random_rhs(L + 1, ncol, seed);
+  Eigen::MatrixXcd U(2 * L + 1, ncol);
+  for (int q = 0; q < ncol; ++q) {
+    U(L, q) = h(0, q).real();
+    for (int l = 1; l <= L; ++l) U(L + l, q) = h(l, q), U(L - l, q) = std::conj(h(l, q));
+  }
+  return U;
+}
+
+// The full-grid A with rows and columns in reverse line order, in LAPACK band storage: its
+// first L - 2K + 1 elimination steps are those of the half-grid route (rows L..K in the
+// unknowns Y_L..Y_0).
+std::vector<cd> reversed_band(const lptv::SpMat& A, int K) {
+  const int n = static_cast<int>(A.rows()), ld = lptv::BandLU::ldab(K, K);
+  std::vector<cd> ab(static_cast<size_t>(ld) * n, cd(0.0, 0.0));
+  for (int j = 0; j < A.outerSize(); ++j)
+    for (lptv::SpMat::InnerIterator it(A, j); it; ++it) {
+      const int r = n - 1 - static_cast<int>(it.row()), c = n - 1 - j;
+      ab[static_cast<size_t>(c) * ld + 2 * K + r - c] = it.value();
+    }
+  return ab;
+}
+
+}  // namespace
+
+TEST_CASE("the half-grid route for a real input equals LAPACK's band LU on the full grid",
+          "[band][fds]") {
+  // Every unrolled bandwidth and the runtime-K code; the smallest grids the route takes
+  // (L = 2K + 1: one band step, the rest in the corner) and larger ones; depth 3 makes both
+  // the band steps and the corner pivot.
+  int pivoting_models = 0;
+  for (int K : {1, 2, 3, 4, 5, 6, 7, 8, 10}) {
+    for (double depth : {0.3, 3.0}) {
+      for (unsigned seed = 0; seed < 3; ++seed) {
+        const lptv::Model m = random_model(K, 31 * K + seed, depth);
+        for (int L : {2 * K + 1, 2 * K + 2, 3 * K + 5, 60}) {
+          CAPTURE(K, depth, seed, L);
+          const lptv::Grid g = lptv::make_grid(m, L);
+          const Eigen::MatrixXcd U = real_input(L, 2, seed + 7);
+          const lptv::SpMat A = lptv::build_A(m, g);
+          const lptv::BandLU lapack(g.N, K, K, band_storage(A, K), col_label);
+          const Eigen::MatrixXcd ref = lapack.solve(lptv::apply_B(m, g, U));
+          const lptv::GridSolution s = lptv::solve_grid(m, L, U, lptv::Solver::Band);
+          REQUIRE(s.solver == lptv::Solver::Band);
+          REQUIRE(rel_diff(s.Y, ref) <= kTol);
+          // The solution is conjugate-symmetric by construction.
+          for (int l = 0; l <= L; ++l) REQUIRE(s.Y.row(L - l) == s.Y.row(L + l).conjugate());
+          // The check: the same magnitudes as the full grid's (the phases differ by a constant).
+          const lptv::Fds fds(m, L, lptv::Solver::Band);
+          REQUIRE(s.condition == Approx(fds.condition()).epsilon(1e-12));
+          // The same solution as the full-grid route on the same input made slightly
+          // non-symmetric (an imaginary part of 1e-300 in U_0: the route cannot fold it).
+          Eigen::MatrixXcd Ua = U;
+          Ua(L, 0) += cd(0.0, 1e-300);
+          const lptv::GridSolution full = lptv::solve_grid(m, L, Ua, lptv::Solver::Band);
+          REQUIRE(rel_diff(s.Y, full.Y) <= kTol);
+          if (L == 60) {
+            const lptv::SmallBandLU rev(g.N, K, reversed_band(A, K), col_label);
+            for (int k = 0; k < L - 2 * K + 1; ++k)
+              if (rev.pivot(k) != 0) {
+                ++pivoting_models;
+                break;
+              }
+          }
+        }
+      }
+    }
+  }
+  REQUIRE(pivoting_models > 0);  // the premise: the band steps pivot for some deep models
+}
+
+TEST_CASE("the one-pass route builds build_A's entries, bit for bit", "[band][fds]") {
+  // The route builds A's rows with band_entry_ct (half the products of band_entry, the same
+  // numbers); with the same entries and right-hand sides the kernel's fused elimination does
+  // the operations of SmallBandLU's factorisation and two substitutions in the same order, so
+  // the solutions agree in every bit. A general (not conjugate-symmetric) input takes the
+  // full-grid route.
+  for (int K : {1, 3, 7, 9}) {
+    for (double depth : {0.3, 3.0}) {
+      const lptv::Model m = random_model(K, 5 * K + 1, depth);
+      const int L = 40;
+      const lptv::Grid g = lptv::make_grid(m, L);
+      const Eigen::MatrixXcd U = random_rhs(g.N, 2, K + 11);
+      const lptv::SmallBandLU lu(g.N, K, band_storage(lptv::build_A(m, g), K), col_label);
+      CAPTURE(K, depth);
+      REQUIRE(lptv::solve_grid(m, L, U, lptv::Solver::Band).Y == lu.solve(lptv::apply_B(m, g, U)));
+    }
+  }
+}
+
+TEST_CASE("the half-grid route names the line of an exactly singular A", "[fds]") {
+  // s^2 + 4 with zero harmonics (Ka = 1): a pole on line 2 / w0. With w0 = 1 the zero pivot is
+  // in the band steps (line 2 >= 2K), with w0 = 2 in the corner (line 1 < 2K).
+  Eigen::MatrixXcd a = Eigen::MatrixXcd::Zero(3, 3), b = Eigen::MatrixXcd::Zero(1, 3);
+  a(0, 1) = 4.0, a(2, 1) = 1.0, b(0, 1) = 1.0;
+  for (double w0 : {1.0, 2.0}) {
+    const lptv::Model m(a, b, w0);
+    const int L = 8;
+    const Eigen::MatrixXcd U = real_input(L, 1, 3);
+    const std::string line = w0 == 1.0 ? "line 2 " : "line 1 ";
+    REQUIRE_THROWS_WITH(lptv::solve_grid(m, L, U, lptv::Solver::Band),
+                        Catch::StartsWith("A is singular at " + line));
+  }
+}
+
 TEST_CASE("the predicted decay beyond the band is the root of a_na's harmonics", "[fds]") {
   // a_1(t) = 1 + 2 rho cos(w0 t + phi): rho e^{-j phi} + lambda + rho e^{j phi} lambda^2 = 0
   // has |lambda| = (1 - sqrt(1 - 4 rho^2)) / (2 rho) and its reciprocal.

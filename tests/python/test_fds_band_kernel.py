@@ -1,6 +1,7 @@
 """The FDS's small band LU (solver 'band', the continuous-time default) against the dense NumPy
 reference for every bandwidth the kernel unrolls (2K+1 = 1..15) and the runtime-K code above,
-several inputs at once, and the HTF's many right-hand sides. Discrete time has no band solver
+several inputs at once, the half-grid route simulate takes for real inputs, and the HTF's many
+right-hand sides. Discrete time has no band solver
 (the grid wraps around); there the default KLU is compared with the same reference."""
 import numpy as np
 import pytest
@@ -40,3 +41,21 @@ def test_discrete_time_default_matches_reference(make_model, make_spectrum, seed
     model = make_model(seed, "dt")
     U = make_spectrum(seed, model)
     assert rel_diff(lptv.simulate(model, U), ref.simulate(model, U)) <= tol.BAND_KERNEL
+
+
+@pytest.mark.parametrize("ka", [k for k in BANDWIDTHS if k > 0])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("depth", [0.2, 0.6])
+def test_half_grid_route_matches_reference(make_model, make_spectrum, kappa, ka, seed, depth, tol):
+    # A real input takes the half-grid route (lines 0..L, the last 2 ka rows as a small real
+    # system) from grids of 2 ka + 1 lines each side; the smallest grids leave one band step.
+    # Guard 0 on input lines 0..Lu: the grid is exactly -Lu..Lu, so 2 ka - 1 .. 2 ka + 2 cross
+    # the smallest grid the route takes (2 ka + 1). Deeper modulation (0.6) makes the low
+    # lines pivot.
+    model = make_model(seed, "ct", ka=ka, kb=min(ka, 3), depth=depth)
+    for Lu in (2 * ka - 1, 2 * ka, 2 * ka + 1, 2 * ka + 2, 40):
+        U = make_spectrum(seed, model, Lu=Lu, ncols=2)
+        if kappa(ref.band_matrix_A(model, Lu)) > tol.KAPPA_MAX:
+            continue
+        Y = lptv.simulate(model, U, guard=0)
+        assert rel_diff(Y, ref.simulate(model, U, guard=0)) <= tol.BAND_KERNEL

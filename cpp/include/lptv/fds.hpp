@@ -85,8 +85,10 @@ class Fds {
 // One grid, one factorisation, the given inputs only (the factors are not kept): what
 // simulate does per grid. Y = A^-1 B U_full for full-grid inputs U_full (grid.N rows, any
 // number of columns), with Fds's conditioning check and its NumericalError. With the band
-// solver the factorisation, B U, the check and both substitutions are one pass over the grid;
-// the other solvers run Fds and Fds::solve_full.
+// solver the factorisation, B U, the check and both substitutions are one pass over the grid
+// (for a real input, U_full exactly conjugate-symmetric about line 0 as simulate builds it,
+// over lines 0..L only: half the work, METHOD.md section 3); the other solvers run Fds and
+// Fds::solve_full.
 struct GridSolution {
   Grid grid;
   Eigen::MatrixXcd Y;
