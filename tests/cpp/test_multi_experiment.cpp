@@ -78,8 +78,12 @@ TEST_CASE("a duplicated experiment gives the same estimate with half the covaria
       const auto two = lptv::identify(std::vector<lptv::FrequencyData>{d, d}, s, opt);
       REQUIRE(two.n_experiments == 2);
       REQUIRE(two.rows.size() == 2 * one.rows.size());
-      // Both stop within tol of the same stationary point (the cost is exactly doubled).
-      REQUIRE(rel(two.theta, one.theta) < 1e-10);
+      // Both stop within tol of the same stationary point (the cost is exactly doubled). WGTLS
+      // solves the same GSVD problem (its R factors agree to rounding); the SML's stationary point
+      // is fixed only to ~sqrt(eps) cond where the cost is flat, the 1e-8 the SML estimate is
+      // held to against the reference (tests/python/test_likelihood_core.py): a one-ulp change
+      // of the simulated data moves it by up to a few 1e-9.
+      REQUIRE(rel(two.theta, one.theta) < (method == lptv::Method::WGTLS ? 1e-10 : 1e-8));
       REQUIRE(rel(2 * two.covariance, one.covariance) < 1e-8);
       REQUIRE(two.cost == Approx(one.cost).epsilon(1e-10));
     }
