@@ -6,7 +6,7 @@ from typing import Optional
 import numpy as np
 
 from . import _core
-from ._validate import check_finite
+from ._validate import as_int, check_finite
 
 
 def _periods_array(x, name):
@@ -65,7 +65,8 @@ class FrequencyData:
             raise ValueError("varU must be >= 0 (a variance)")
         if np.any(varY < 0):
             raise ValueError("varY must be >= 0 (a variance)")
-        self._set(_core.FrequencyData(U, Y, varU, varY, covYU, int(periods)), w0, ts)
+        periods = as_int(periods, "periods")  # 0: the variances came from elsewhere
+        self._set(_core.FrequencyData(U, Y, varU, varY, covYU, periods), w0, ts)
 
     def _set(self, cpp, w0, ts):
         if w0 is None or not np.isfinite(w0) or w0 <= 0:

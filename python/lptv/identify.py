@@ -12,7 +12,7 @@ import numpy as np
 from . import _core
 from .data import FrequencyData, frequency_data_of
 from .model import Model
-from ._validate import as_positive_float
+from ._validate import INT_MAX, as_positive_float
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 
@@ -246,10 +246,16 @@ class IdentificationResult:
         return "\n".join(lines)
 
 
+# Orders beyond this would only build huge per-coefficient lists before the core refuses them.
+MAX_COEFFICIENTS = 2**20
+
+
 def _counts(k, n, name):
     if np.ndim(k) == 0:
         if int(k) != k or k < 0:
             raise ValueError(f"{name} must be a non-negative integer or one per coefficient, got {k!r}")
+        if k > INT_MAX:
+            raise ValueError(f"{name} must be at most {INT_MAX}, got {k!r}")
         return [int(k)] * (n + 1)
     ks = list(k)
     if len(ks) != n + 1:
@@ -257,6 +263,8 @@ def _counts(k, n, name):
     for v in ks:
         if int(v) != v or v < 0:
             raise ValueError(f"{name}: harmonic counts must be non-negative integers, got {ks}")
+        if v > INT_MAX:
+            raise ValueError(f"{name}: harmonic counts must be at most {INT_MAX}, got {ks}")
     return [int(v) for v in ks]
 
 
@@ -302,10 +310,18 @@ def _rows(lines):
         raise ValueError("lines must be a non-empty 1-D sequence of integers")
     if not np.issubdtype(rows.dtype, np.integer):
         if np.issubdtype(rows.dtype, np.floating) and np.all(rows == np.round(rows)):
-            rows = rows.astype(int)
+            rows = rows.astype(object)  # exact, whatever the magnitude; range-checked below
         else:
             raise ValueError(f"lines must be integers, got dtype {rows.dtype}")
-    return [int(r) for r in rows]
+    rows = [int(r) for r in rows]
+    # The core's lines are C ints; a larger row cannot be a line of any record.
+    for r in rows:
+        shown = r if abs(r) < 10**20 else f"{float(r):.6g}"
+        if r < -INT_MAX - 1:
+            raise ValueError(f"lines: row {shown} is not a positive line (rows are lines >= 1)")
+        if r > INT_MAX:
+            raise ValueError(f"lines: row {shown} is beyond the largest line of any record ({INT_MAX})")
+    return rows
 
 
 _DEFAULT_LINES = "excited"  # what lines=None means: the usable lines K+1..Lmax-K
@@ -330,6 +346,8 @@ def excited_rows(data: FrequencyData, K: int = 0, ratio: float = 100.0) -> np.nd
     if ex.size == 0:
         raise ValueError("lines='excited': no line of the input stands above its noise; pass lines explicitly")
     K = int(K)
+    if 2 * K + 1 > data.max_line:  # no usable rows; and the +-K offsets below would not fit memory
+        raise ValueError(f"lines='excited': no excited line lies within the usable rows {K + 1}..{data.max_line - K}")
     rows = np.unique((ex[:, None] + np.arange(-K, K + 1)[None, :]).ravel())
     rows = rows[(rows >= K + 1) & (rows <= data.max_line - K)]
     if rows.size == 0:
@@ -396,11 +414,18 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     for name, v in (("na", na), ("nb", nb)):
         if np.ndim(v) != 0 or int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+        if v > INT_MAX:
+            raise ValueError(f"{name} must be at most {INT_MAX}, got {v!r}")
     if not (np.isfinite(tol) and tol > 0):
         raise ValueError(f"tol must be > 0, got {tol!r}")
     if int(max_iter) != max_iter or max_iter < 0:
         raise ValueError(f"max_iter must be a non-negative integer, got {max_iter!r}")
+    if max_iter > INT_MAX:
+        raise ValueError(f"max_iter must be at most {INT_MAX}, got {max_iter!r}")
     na, nb = int(na), int(nb)
+    if na + nb + 2 > MAX_COEFFICIENTS:  # refused before the per-coefficient lists below are built
+        raise ValueError(f"na = {na} and nb = {nb} give {na + nb + 2} coefficients, more than any fit "
+                         f"can hold (the core estimates at most 4000 complex parameters)")
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
