@@ -101,7 +101,7 @@ SAN_FUZZ_EXAMPLES ?= 1500
 # Deselected under the sanitizers (reason each):
 #   test_report_browser.py: renders report.html in Chromium, which cannot run with the
 #   preloaded ASan runtime; the report's Python side is covered by test_cli_identify.py.
-SAN_DESELECT := --deselect test_report_browser.py
+SAN_DESELECT := --ignore=test_report_browser.py
 # Extra pytest arguments, e.g. make sanitize-pytest SAN_PYTEST_ARGS=test_fds.py
 SAN_PYTEST_ARGS ?=
 

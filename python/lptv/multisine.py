@@ -67,6 +67,9 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
         if not (np.issubdtype(ln.dtype, np.floating) and np.all(np.isfinite(ln))
                 and np.all(ln == np.round(ln))):
             raise ValueError(f"lines must be integers, got {ln.dtype} values")
+        if np.any(ln < 0) or np.any(ln > n_samples // 2):  # before a cast that would wrap them
+            raise ValueError(f"lines must lie in 0..{n_samples // 2} (n_samples//2), "
+                             f"got {ln.min():.6g}..{ln.max():.6g}")
         ln = ln.astype(int)
     if ln.ndim != 1:
         raise ValueError(f"lines must be 1-D, got shape {ln.shape}")

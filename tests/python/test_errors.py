@@ -509,3 +509,9 @@ def test_frequency_data_periods_must_be_a_count(periods, match):
     with pytest.raises(ValueError, match=match):
         lptv.FrequencyData(ones, ones, ones, ones, w0=1.0, periods=periods)
     assert lptv.FrequencyData(ones, ones, ones, ones, w0=1.0, periods=3.0).periods == 3
+
+
+def test_multisine_lines_beyond_int64_are_reported_as_given():
+    # [2**63, -1] is a float64 array; its cast to int wrapped 2**63 to -2**63 in the message.
+    with pytest.raises(ValueError, match=r"^lines must lie in 0..8 \(n_samples//2\), got -1..9.22337e\+18$"):
+        lptv.multisine([2**63, -1], 16)
