@@ -126,7 +126,7 @@ sanitize-cpp: sanitize-build
 sanitize-pytest: sanitize-build
 	cd tests/python && LD_PRELOAD=$(SAN_RUNTIMES) $(SAN_ASAN):detect_leaks=0 $(SAN_UBSAN) \
 	  LPTV_FUZZ_EXAMPLES=$(SAN_FUZZ_EXAMPLES) PYTHONPATH=$(abspath $(SAN))/python \
-	  $(abspath $(PY)) -m pytest -q -p no:cacheprovider $(SAN_DESELECT) $(SAN_PYTEST_ARGS)
+	  $(abspath $(PY)) -m pytest -q -p no:cacheprovider --capture=sys $(SAN_DESELECT) $(SAN_PYTEST_ARGS)
 
 sanitize: sanitize-cpp sanitize-pytest
 
