@@ -97,7 +97,7 @@ SAN_RUNTIMES = $$(g++ -print-file-name=libasan.so):$$(g++ -print-file-name=libub
 SAN_UBSAN := UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 SAN_ASAN := ASAN_OPTIONS=abort_on_error=1:detect_stack_use_after_return=1:strict_string_checks=1
 # Hypothesis examples per property test in the sanitized run (150 in make test).
-SAN_FUZZ_EXAMPLES ?= 1500
+SAN_FUZZ_EXAMPLES ?= 5000
 # Deselected under the sanitizers (reason each):
 #   test_report_browser.py: renders report.html in Chromium, which cannot run with the
 #   preloaded ASan runtime; the report's Python side is covered by test_cli_identify.py.

@@ -14,7 +14,7 @@ import lptv
 
 # Deterministic (derandomize) so that a run in CI is reproducible; modest counts keep the file
 # at a few seconds. LPTV_FUZZ_EXAMPLES raises the count (make sanitize runs this file under
-# ASan + UBSan with 1500 examples per test).
+# ASan + UBSan with 5000 examples per test).
 FUZZ_EXAMPLES = int(os.environ.get("LPTV_FUZZ_EXAMPLES", "150"))
 FUZZ = settings(max_examples=FUZZ_EXAMPLES, deadline=None, derandomize=True, database=None,
                 suppress_health_check=[HealthCheck.too_slow])

@@ -515,3 +515,17 @@ def test_multisine_lines_beyond_int64_are_reported_as_given():
     # [2**63, -1] is a float64 array; its cast to int wrapped 2**63 to -2**63 in the message.
     with pytest.raises(ValueError, match=r"^lines must lie in 0..8 \(n_samples//2\), got -1..9.22337e\+18$"):
         lptv.multisine([2**63, -1], 16)
+
+
+@pytest.mark.parametrize("a", [
+    [[1.0e308], [1.0]],
+    [[0.1 + 0.2j, 1.5e308, 0.1 - 0.2j], [0.0, 1.0, 0.0]],
+    [[1.5e308 - 1.0e308j, 0.5, 1.5e308 + 1.0e308j], [0.0, 1.0, 0.0]],
+], ids=["mean", "harmonic-0", "harmonic-1"])
+def test_coefficients_near_the_largest_double_stay_finite(a):
+    # The exact symmetrisation took (x + conj(y)) / 2, and x + x overflowed to inf: a model with
+    # an infinite coefficient, silently.
+    a = np.array(a, dtype=complex)
+    m = lptv.Model(a, [[1.0]], w0=1.0)
+    assert np.all(np.isfinite(m.a))
+    np.testing.assert_array_equal(m.a, a)  # already symmetric: kept bit for bit
