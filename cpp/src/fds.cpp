@@ -41,6 +41,16 @@ Grid make_grid(const Model& m, int L) {
   if (m.discrete()) {
     g.circular = true;
     g.N = m.samples_per_period();
+    // The circular grid holds all N lines: the same bound as the continuous grid -L..L.
+    constexpr int kMaxSamples = 2 * (1 << 26) + 1;
+    if (g.N > kMaxSamples) {
+      const double gb = static_cast<double>(g.N) * 16.0 * (3.0 * m.kmax() + 4) / 1e9;
+      throw std::invalid_argument("the grid of the model's " + std::to_string(g.N) +
+                                  " samples per period is too large (at most " +
+                                  std::to_string(kMaxSamples) +
+                                  " lines): its band factors alone would take about " +
+                                  std::to_string(static_cast<long long>(gb + 0.5)) + " GB");
+    }
     g.L = g.N / 2;
   } else {
     if (L < 0) throw std::invalid_argument("L must be >= 0, got " + std::to_string(L));
@@ -589,7 +599,10 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
   const bool half = (opt.solver == Solver::Auto || opt.solver == Solver::Band) &&
                     use_small_band(m) && U.row(0).imag().isZero(0.0);
   auto run = [&](int band_lines, int guard) {
-    const Grid g = make_grid(m, band_lines + guard);
+    // A guard given by the caller can be anything up to INT_MAX: add in 64 bits.
+    const long long L = static_cast<long long>(band_lines) + guard;
+    check_grid_size(L, m.kmax());
+    const Grid g = make_grid(m, static_cast<int>(L));
     if (half && detail::can_fold(m, g)) {
       const detail::FoldedSolution s =
           solve_half(m, g, U.topRows(std::min<Eigen::Index>(U.rows(), g.L + 1)));

@@ -64,7 +64,10 @@ Model::Model(Eigen::MatrixXcd a, Eigen::MatrixXcd b, double w0, double ts)
     const Eigen::Index K = (c->cols() - 1) / 2;
     for (Eigen::Index n = 0; n < c->rows(); ++n) {
       for (Eigen::Index k = 0; k <= K; ++k) {
-        const cd v = 0.5 * ((*c)(n, K + k) + std::conj((*c)(n, K - k)));
+        // The midpoint as x + (y - x) / 2: exact when the pair is already symmetric, and no
+        // overflow of x + y for entries near the largest double (x + y gave inf).
+        const cd x = (*c)(n, K + k);
+        const cd v = x + 0.5 * (std::conj((*c)(n, K - k)) - x);
         (*c)(n, K + k) = v;
         (*c)(n, K - k) = std::conj(v);
       }

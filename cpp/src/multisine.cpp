@@ -7,9 +7,24 @@
 
 namespace lptv {
 
+// A period longer than the largest simulation grid (2^26 lines each side, fds.cpp) cannot be
+// simulated; refusing it here also keeps the FFT's buffers (about 56 bytes a sample) in memory
+// instead of failing the allocation.
+static void check_n_samples(int n_samples) {
+  constexpr int kMaxSamples = 2 * (1 << 26) + 1;
+  if (n_samples < 1) throw std::invalid_argument("n_samples must be >= 1, got " + std::to_string(n_samples));
+  if (n_samples > kMaxSamples) {
+    const double gb = 56.0 * static_cast<double>(n_samples) / 1e9;
+    throw std::invalid_argument("n_samples = " + std::to_string(n_samples) + " is too large (at most " +
+                                std::to_string(kMaxSamples) + ", the largest simulation grid): the " +
+                                "signal and its FFT would take about " +
+                                std::to_string(static_cast<long long>(gb + 0.5)) + " GB");
+  }
+}
+
 Eigen::VectorXcd multisine_spectrum(const std::vector<int>& lines, const Eigen::VectorXd& amplitudes,
                                     const Eigen::VectorXd& phases, int n_samples) {
-  if (n_samples < 1) throw std::invalid_argument("n_samples must be >= 1");
+  check_n_samples(n_samples);
   if (amplitudes.size() != static_cast<Eigen::Index>(lines.size()) ||
       phases.size() != static_cast<Eigen::Index>(lines.size())) {
     throw std::invalid_argument("amplitudes and phases must have one entry per line");
@@ -35,7 +50,7 @@ Eigen::VectorXcd multisine_spectrum(const std::vector<int>& lines, const Eigen::
 }
 
 Eigen::VectorXd time_signal(const Eigen::VectorXcd& X, int n_samples) {
-  if (n_samples < 1) throw std::invalid_argument("n_samples must be >= 1, got " + std::to_string(n_samples));
+  check_n_samples(n_samples);
   if (!X.allFinite()) throw std::invalid_argument("X contains NaN or inf");
   const int half = n_samples / 2;
   if (X.size() < 1 || X.size() - 1 > half) {

@@ -198,6 +198,10 @@ def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str
     L = as_int(L, "L", maximum=MAX_GRID_LINES)
     solver = as_str(solver, "solver", SOLVERS)
     n = model.samples_per_period if model.discrete else 2 * L + 1
+    if model.discrete and n > 2 * MAX_GRID_LINES + 1:
+        # as in the core, and before a default list of n input lines is built
+        raise ValueError(f"the grid of the model's {n} samples per period is too large "
+                         f"(at most {2 * MAX_GRID_LINES + 1} lines)")
     if lines is None:
         lines = range(n) if model.discrete else range(-L, L + 1)
     try:

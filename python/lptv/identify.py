@@ -343,6 +343,10 @@ class IdentificationResult:
         return "\n".join(lines)
 
 
+# Orders beyond this would only build huge per-coefficient lists before the core refuses them.
+MAX_COEFFICIENTS = 2**20
+
+
 def _counts(k, n, name):
     return as_counts(k, n, name)
 
@@ -406,6 +410,8 @@ def excited_rows(data: FrequencyData, K: int = 0, ratio: float = 100.0) -> np.nd
     if ex.size == 0:
         raise ValueError("lines='excited': no line of the input stands above its noise; pass lines explicitly")
     K = int(K)
+    if 2 * K + 1 > data.max_line:  # no usable rows; and the +-K offsets below would not fit memory
+        raise ValueError(f"lines='excited': no excited line lies within the usable rows {K + 1}..{data.max_line - K}")
     rows = np.unique((ex[:, None] + np.arange(-K, K + 1)[None, :]).ravel())
     rows = rows[(rows >= K + 1) & (rows <= data.max_line - K)]
     if rows.size == 0:
@@ -505,6 +511,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     else:
         data = frequency_data_of(u, y, w0, ts)
     ts = data.ts if ts is None else ts
+    if na + nb + 2 > MAX_COEFFICIENTS:  # refused before the per-coefficient lists below are built
+        raise ValueError(f"na = {na} and nb = {nb} give {na + nb + 2} coefficients, more than any fit "
+                         f"can hold (the core estimates at most 4000 complex parameters)")
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))

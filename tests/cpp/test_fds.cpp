@@ -131,3 +131,34 @@ TEST_CASE("simulate reports the condition of the lines with input, and where", "
   REQUIRE(p.condition > lptv::Fds::kWarnCondition);
   REQUIRE(p.condition_line == 1);
 }
+
+TEST_CASE("sizes near INT_MAX are refused before anything is allocated", "[fds][limits]") {
+  Eigen::MatrixXcd a(2, 3), b(1, 1);
+  a << cd(0.1, 0.0), 2.0, cd(0.1, 0.0), 0.0, 1.0, 0.0;
+  b << 1.0;
+  const lptv::Model ct(a, b, 0.1);
+  Eigen::MatrixXcd U = Eigen::MatrixXcd::Ones(10, 1);
+  // A fixed guard near INT_MAX: highest line + guard overflowed an int (negative L).
+  lptv::SimulateOptions opt;
+  opt.guard = 2147483647;
+  REQUIRE_THROWS_WITH(lptv::simulate(ct, U, opt),
+                      Catch::Contains("-2147483656..2147483656 is too large") && Catch::Contains("GB"));
+  // A discrete-time grid of 2^31 - 1 lines was allocated (std::bad_alloc).
+  Eigen::MatrixXcd ad(2, 1), bd(1, 1);
+  ad << 0.3, 1.0;
+  bd << 1.0;
+  const lptv::Model dt(ad, bd, 2 * M_PI / 2147483647.0, 1.0);
+  REQUIRE(dt.samples_per_period() == 2147483647);
+  REQUIRE_THROWS_WITH(lptv::make_grid(dt, 0), Catch::Contains("2147483647 samples per period is too large"));
+  REQUIRE_THROWS_WITH(lptv::simulate(dt, Eigen::MatrixXcd::Ones(3, 1)),
+                      Catch::Contains("2147483647 samples per period is too large"));
+  // The largest grid still passes the check: 2^27 + 1 samples per period (no simulation here).
+  const lptv::Model dt_max(ad, bd, 2 * M_PI / 134217729.0, 1.0);
+  REQUIRE(lptv::make_grid(dt_max, 0).N == 134217729);
+  // A multisine period of 2^31 - 1 samples: the same bound (it was allocated, std::bad_alloc).
+  const Eigen::VectorXd one = Eigen::VectorXd::Ones(1);
+  REQUIRE_THROWS_WITH(lptv::multisine_spectrum({1}, one, one, 2147483647),
+                      Catch::Contains("n_samples = 2147483647 is too large (at most 134217729"));
+  REQUIRE_THROWS_WITH(lptv::time_signal(Eigen::VectorXcd::Ones(1), 134217730),
+                      Catch::Contains("n_samples = 134217730 is too large"));
+}

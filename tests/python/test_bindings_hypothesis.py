@@ -1,6 +1,7 @@
 """Property tests of the input handling: random shapes, dtypes and values into lptv.Model,
 lptv.simulate and lptv.multisine give either a correct result or ValueError / NumericalError,
 never another exception, a crash, or NaN in the output."""
+import os
 import warnings
 
 import numpy as np
@@ -12,8 +13,10 @@ from hypothesis.extra import numpy as hnp
 import lptv
 
 # Deterministic (derandomize) so that a run in CI is reproducible; modest counts keep the file
-# at a few seconds.
-FUZZ = settings(max_examples=150, deadline=None, derandomize=True, database=None,
+# at a few seconds. LPTV_FUZZ_EXAMPLES raises the count (make sanitize runs this file under
+# ASan + UBSan with 5000 examples per test).
+FUZZ_EXAMPLES = int(os.environ.get("LPTV_FUZZ_EXAMPLES", "150"))
+FUZZ = settings(max_examples=FUZZ_EXAMPLES, deadline=None, derandomize=True, database=None,
                 suppress_health_check=[HealthCheck.too_slow])
 
 ACCEPTED = (ValueError, lptv.NumericalError)
@@ -199,3 +202,168 @@ def test_multisine_inputs(lines, n_samples, amplitudes, seed):
     # Only excited lines carry anything.
     others = np.setdiff1d(np.arange(N // 2 + 1), ms.lines)
     assert np.all(ms.spectrum[others] == 0)
+
+
+# ------------------------------------------------------------ sizes, lines and orders from users
+
+# Integers a user may type where the core holds a C int: beyond the largest grid (2^26 lines each
+# side), at and beyond INT_MAX, beyond 64 bits, and far negative. Valid but huge sizes (a grid of
+# 2^26 lines takes gigabytes) are not drawn: every value here must be refused.
+HUGE = st.sampled_from([2**26 + 65, 2**27 + 2, 2**30, 2**31 - 2, 2**31 - 1, 2**31, 2**32 + 1,
+                        2**63 - 1, 2**63, 2**64, -2**31 + 1, -2**31, -2**31 - 1, -2**63])
+
+
+def sizes(lo, hi):
+    return st.one_of(st.integers(lo, hi), st.integers(lo, hi), HUGE)
+
+
+def quiet(call):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return call()
+
+
+def _example_periods(P=4, N=64, ts=None):
+    """P noisy periods of a first-order LPTV system (a1(t) = 1 + 0.2 cos t) under a multisine."""
+    m = lptv.Model(np.array([[0.05, 2.0, 0.05], [0.1, 1.0, 0.1]]), [[1.0]], w0=1.0,
+                   ts=None if ts is None else 2 * np.pi / N)
+    ms = lptv.multisine(range(1, N // 2 - 4, 2), N, seed=0)
+    y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), N)
+    rng = np.random.default_rng(3)
+    return (ms.periods(P) + 1e-3 * rng.standard_normal((P, N)),
+            np.tile(y1, (P, 1)) + 1e-3 * rng.standard_normal((P, N)))
+
+
+U_P, Y_P = _example_periods()
+DATA = lptv.FrequencyData.from_periods(U_P, Y_P, w0=1.0)
+
+ROWS = st.one_of(st.none(), st.just("excited"),
+                 st.lists(sizes(-3, 40), min_size=1, max_size=12),
+                 st.builds(lambda a, n, extra: list(range(a, a + n)) + extra, st.integers(-2, 30),
+                           st.integers(1, 30), st.lists(HUGE, max_size=2)),
+                 st.lists(st.sampled_from([3.0, 4.0, 2.5, 1e300, -1e300, np.nan]), min_size=1,
+                          max_size=4))
+COUNTS = st.one_of(sizes(0, 3), st.lists(sizes(0, 3), min_size=1, max_size=4))
+
+
+def assert_identified(res):
+    assert_finite(res.model.a)
+    assert_finite(res.model.b)
+    assert np.all(np.isfinite(res.residue))
+
+
+@FUZZ
+@given(na=sizes(0, 3), nb=sizes(0, 2), ka=COUNTS, kb=COUNTS, lines=ROWS,
+       method=st.sampled_from(lptv.METHODS),
+       max_iter=st.one_of(st.integers(0, 4), st.sampled_from([-1, 2**31, 2**63])))
+def test_identify_sizes_and_lines(na, nb, ka, kb, lines, method, max_iter):
+    try:
+        res = quiet(lambda: lptv.identify(U_P, Y_P, na=na, nb=nb, ka=ka, kb=kb, w0=1.0,
+                                          lines=lines, method=method, max_iter=max_iter))
+    except ACCEPTED as e:
+        assert str(e)
+        event(f"rejected: {type(e).__name__}")
+        return
+    event("accepted")
+    assert_identified(res)
+
+
+@st.composite
+def frequency_data(draw):
+    """Spectra and variances of any shape and dtype (mostly of one consistent length), and
+    periods of any size."""
+    n = draw(st.integers(0, 40))
+    consistent = hnp.arrays(np.float64, n, elements=st.floats(0, 10))
+    parts = [draw(st.one_of(consistent, consistent, consistent, arrays_of_any_kind(max_dims=2)))
+             for _ in range(4)]
+    periods = draw(st.one_of(sizes(0, 8), st.sampled_from([2.5, np.nan, -1.0])))
+    return parts, periods
+
+
+@FUZZ
+@given(fd=frequency_data(), method=st.sampled_from(lptv.METHODS), na=sizes(0, 2),
+       K=st.integers(0, 2))
+def test_frequency_data_inputs(fd, method, na, K):
+    (U, Y, varU, varY), periods = fd
+    try:
+        data = lptv.FrequencyData(U, Y, varU, varY, w0=1.0, periods=periods)
+    except ACCEPTED as e:
+        assert str(e)
+        event("rejected: FrequencyData")
+        return
+    assert data.periods == periods and data.periods >= 0
+    try:
+        res = quiet(lambda: lptv.identify(data, na=na, nb=0, ka=K, method=method, max_iter=3))
+    except ACCEPTED as e:
+        assert str(e)
+        event(f"identify rejected: {type(e).__name__}")
+        return
+    event("accepted")
+    assert_identified(res)
+
+
+GRID_MODELS = dict(MODELS, **{
+    # samples per period far beyond the largest grid: every grid of it must be refused
+    f"dt-N{N}": lptv.Model([[0.3], [1.0]], [[1.0]], w0=2 * np.pi / N, ts=1.0)
+    for N in (2**27 + 3, 2**31 - 1)})
+
+
+@FUZZ
+@given(name=st.sampled_from(sorted(GRID_MODELS)), L=sizes(-2, 40),
+       lines=st.one_of(st.none(), st.lists(sizes(-45, 45), max_size=4)),
+       lines_out=st.one_of(st.none(), sizes(-2, 40)), guard=st.one_of(st.none(), sizes(-2, 40)),
+       max_guard=st.one_of(st.none(), st.integers(-2, 200), st.sampled_from([2**31, 2**63])),
+       call=st.sampled_from(["band_matrices", "htf", "simulate"]))
+def test_grid_sizes(name, L, lines, lines_out, guard, max_guard, call):
+    model = GRID_MODELS[name]
+    try:
+        if call == "band_matrices":
+            A, B = lptv.band_matrices(model, L)
+            n = model.samples_per_period if model.discrete else 2 * L + 1
+            assert A.shape == (n, n) and B.shape == (n, n)
+            assert_finite(A.data)
+        elif call == "htf":
+            G = lptv.htf(model, L, lines)
+            n = model.samples_per_period if model.discrete else 2 * L + 1
+            assert G.shape == (n, n if lines is None else len(lines))
+            assert_finite(G)
+        else:
+            U = np.ones(4 if lines_out is None or model.discrete else 3)
+            Y = quiet(lambda: lptv.simulate(model, U, lines_out=lines_out, guard=guard,
+                                            max_guard=max_guard))
+            assert Y.shape == (U.size if lines_out is None else lines_out + 1,)
+            assert_finite(Y)
+    except ACCEPTED as e:
+        assert str(e)
+        event(f"rejected: {call}")
+        return
+    event(f"accepted: {call}")
+
+
+# Periods beyond the largest multisine (2^27 + 1 samples, one grid of 2^26 lines each side).
+HUGE_PERIODS = HUGE.filter(lambda n: n > 2**27 + 1 or n < 0)
+
+
+@FUZZ
+@given(lines=st.lists(sizes(-3, 40), max_size=5),
+       n_samples=st.one_of(st.integers(-2, 100), st.integers(-2, 100), HUGE_PERIODS),
+       X=st.lists(st.floats(-10, 10), min_size=1, max_size=5))
+def test_multisine_and_time_signal_sizes(lines, n_samples, X):
+    try:
+        ms = lptv.multisine(lines, n_samples, seed=0)
+    except ACCEPTED as e:
+        assert str(e)
+        event("multisine rejected")
+    else:
+        event("multisine accepted")
+        assert ms.signal.shape == (n_samples,)
+        assert_finite(ms.signal)
+    try:
+        x = lptv.time_signal(X, n_samples)
+    except ACCEPTED as e:
+        assert str(e)
+        event("time_signal rejected")
+    else:
+        event("time_signal accepted")
+        assert x.shape == (n_samples,)
+        assert_finite(x)

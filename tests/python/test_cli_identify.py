@@ -369,3 +369,23 @@ def test_console_script_entry_point():
     assert getattr(importlib.import_module(target.group(1)), target.group(2)) is cli.main
     p = subprocess.run([*LPTV, "--help"], capture_output=True, text=True, timeout=120)
     assert p.returncode == 0 and p.stdout.startswith("usage: lptv ")
+
+
+@pytest.mark.parametrize("lines, text", [
+    ("2-40,2147483647", "lines: row 2147483647 needs lines up to 2147483648 (K = 1 harmonics) "
+                        "but the data has lines 0..128"),
+    ("2-40,9223372036854775808", "lines: row 9223372036854775808 is beyond the largest line of any "
+                                 "record (2147483647)"),
+])
+def test_lines_beyond_int_give_one_line_error(lines, text, tmp_path, capsys):
+    # 1 / (s + 2) at w0 = 0.1, 4 noisy periods of 256 samples
+    m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)
+    ms = lptv.multisine(range(1, 60), 256, seed=0)
+    y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
+    rng = np.random.default_rng(1)
+    src = _npz(tmp_path, "good.npz", u=ms.periods(4) + 1e-3 * rng.standard_normal((4, 256)),
+               y=np.tile(y1, (4, 1)) + 1e-3 * rng.standard_normal((4, 256)), w0=0.1)
+    rc, out, err = identify_cli(capsys, src, "--na", 1, "--nb", 0, "--ka", 1, "--lines", lines,
+                                "--out", tmp_path / "o")
+    _check_one_line_error(rc, out, err, src, text)
+    assert not (tmp_path / "o").exists()

@@ -419,3 +419,113 @@ def test_grids_beyond_int_range_are_refused_before_allocating(call, match):
     M = lptv.Model([[1.0, 2.0, 1.0], [0.0, 1.0, 0.0]], [[0.0, 1.0, 0.0]], w0=0.1)
     with pytest.raises(ValueError, match=match):
         call(M)
+
+
+# ------------------------------------------------- sizes from users beyond the grids and C ints
+
+def _data_256():
+    """The 256-sample record of the tests above: 1 / (s + 2), w0 = 0.1, 4 noisy periods."""
+    m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)
+    ms = lptv.multisine(range(1, 60), 256, seed=0)
+    y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
+    rng = np.random.default_rng(1)
+    return (ms.periods(4) + 1e-3 * rng.standard_normal((4, 256)),
+            np.tile(y1, (4, 1)) + 1e-3 * rng.standard_normal((4, 256)))
+
+
+# A discrete-time model of 2^31 - 1 samples per period (w0 ts = 2 pi / (2^31 - 1)).
+def _dt_huge():
+    return lptv.Model([[0.3], [1.0]], [[1.0]], w0=2 * np.pi / (2**31 - 1), ts=1.0)
+
+
+@pytest.mark.parametrize("call, match", [
+    pytest.param(lambda M: lptv.simulate(M, np.ones(10), guard=2**31 - 1),
+                 r"grid of lines -2147483656\.\.2147483656 is too large .* GB", id="guard-int-max"),
+    pytest.param(lambda M: lptv.simulate(_dt_huge(), np.ones(3)),
+                 "the model's 2147483647 samples per period is too large .* GB", id="dt-simulate"),
+    pytest.param(lambda M: lptv.band_matrices(_dt_huge()),
+                 "the model's 2147483647 samples per period is too large .* GB", id="dt-band"),
+    pytest.param(lambda M: lptv.htf(_dt_huge(), 0, lines=[0]),
+                 "the model's 2147483647 samples per period is too large", id="dt-htf-lines"),
+    pytest.param(lambda M: lptv.htf(_dt_huge(), 0),
+                 "the model's 2147483647 samples per period is too large", id="dt-htf-default"),
+    pytest.param(lambda M: lptv.multisine([1], 2**31 - 1),
+                 r"n_samples = 2147483647 is too large \(at most 134217729.* GB", id="multisine"),
+    pytest.param(lambda M: lptv.time_signal([1.0], 2**31 - 1),
+                 r"n_samples = 2147483647 is too large \(at most 134217729.* GB", id="time_signal"),
+])
+def test_sizes_beyond_the_largest_grid_are_refused_before_allocating(call, match):
+    """A fixed guard near INT_MAX overflowed band + guard (an int) into a negative L; a discrete
+    grid or a multisine period of 2^31 - 1 samples was allocated (std::bad_alloc, or with the
+    default input lines of htf a Python list of 2^31 entries)."""
+    import resource
+
+    M = lptv.Model([[1.0, 2.0, 1.0], [0.0, 1.0, 0.0]], [[0.0, 1.0, 0.0]], w0=0.1)
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(ValueError, match=match):
+        call(M)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100_000  # KB: < 100 MB
+
+
+def test_the_largest_multisine_period_is_the_largest_grid():
+    # The bound of n_samples is the continuous grid's 2^26 lines each side, not less: a period of
+    # 2^27 + 1 samples has its lines 0..2^26 on that grid; one sample more does not.
+    with pytest.raises(ValueError, match="n_samples = 134217730 is too large"):
+        lptv.multisine([1], 2 * 2**26 + 2)
+    with pytest.raises(ValueError, match="lines must lie in 0..67108864"):
+        lptv.multisine([2**26 + 1], 2 * 2**26 + 1)
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(max_iter=2**31), "^max_iter must be at most 2147483647, got 2147483648$"),
+    (dict(ka=2**31), "^ka must be at most 2147483647, got 2147483648$"),
+    (dict(kb=[2**31]), r"^kb: harmonic counts must be at most 2147483647, got \[2147483648\]$"),
+    (dict(na=2**31 - 1), "^na = 2147483647 and nb = 0 give 2147483649 coefficients"),
+    (dict(lines=[2**63] + list(range(2, 40))),
+     r"^lines: row 9223372036854775808 is beyond the largest line of any record \(2147483647\)$"),
+    (dict(lines=[3.0, 1e300]), r"^lines: row 1e\+300 is beyond the largest line"),
+    (dict(lines=[-2**40, 3]), r"^lines: row -1099511627776 is not a positive line"),
+    (dict(ka=2**31 - 1, lines="excited"),
+     r"^lines='excited': no excited line lies within the usable rows 2147483648\.\.-2147483519$"),
+])
+def test_counts_and_lines_beyond_int_are_value_errors_naming_the_argument(kw, match):
+    """They reached the compiled core as Python ints it cannot hold: a TypeError listing the
+    binding's signatures instead of the argument at fault; na = 2^31 - 1 built per-coefficient
+    lists of 2^31 entries, ka = 2^31 - 1 with lines='excited' an array of 2^32 offsets."""
+    u, y = _data_256()
+    args = dict(dict(na=1, nb=0, w0=0.1), **kw)
+    with pytest.raises(ValueError, match=match):
+        lptv.identify(u, y, **args)
+
+
+@pytest.mark.parametrize("periods, match", [
+    (-1, "^periods must be a non-negative integer, got -1$"),
+    (2.5, "^periods must be an integer, got 2.5$"),
+    (2**40, "^periods must be at most 2147483647, got 1099511627776$"),
+])
+def test_frequency_data_periods_must_be_a_count(periods, match):
+    # -1 and 2.5 were accepted (2.5 truncated to 2), 2^40 was a TypeError of the binding.
+    ones = np.ones(8)
+    with pytest.raises(ValueError, match=match):
+        lptv.FrequencyData(ones, ones, ones, ones, w0=1.0, periods=periods)
+    assert lptv.FrequencyData(ones, ones, ones, ones, w0=1.0, periods=3.0).periods == 3
+
+
+def test_multisine_lines_beyond_int64_are_reported_as_given():
+    # [2**63, -1] is a float64 array; its cast to int wrapped 2**63 to -2**63 in the message.
+    with pytest.raises(ValueError, match=r"^lines must lie in 0..8 \(n_samples//2\), got -1..9.22337e\+18$"):
+        lptv.multisine([2**63, -1], 16)
+
+
+@pytest.mark.parametrize("a", [
+    [[1.0e308], [1.0]],
+    [[0.1 + 0.2j, 1.5e308, 0.1 - 0.2j], [0.0, 1.0, 0.0]],
+    [[1.5e308 - 1.0e308j, 0.5, 1.5e308 + 1.0e308j], [0.0, 1.0, 0.0]],
+], ids=["mean", "harmonic-0", "harmonic-1"])
+def test_coefficients_near_the_largest_double_stay_finite(a):
+    # The exact symmetrisation took (x + conj(y)) / 2, and x + x overflowed to inf: a model with
+    # an infinite coefficient, silently.
+    a = np.array(a, dtype=complex)
+    m = lptv.Model(a, [[1.0]], w0=1.0)
+    assert np.all(np.isfinite(m.a))
+    np.testing.assert_array_equal(m.a, a)  # already symmetric: kept bit for bit
