@@ -42,10 +42,15 @@ def as_int(x, name, minimum=0, maximum=INT_MAX):
     v = int(v)
     if v < minimum:
         kind = {0: "a non-negative integer", 1: "a positive integer"}.get(minimum, f"an integer >= {minimum}")
-        raise ValueError(f"{name} must be {kind}, got {v}")
+        raise ValueError(f"{name} must be {kind}, got {_shown(v)}")
     if v > maximum:
-        raise ValueError(f"{name} must be at most {maximum}, got {v}")
+        raise ValueError(f"{name} must be at most {maximum}, got {_shown(v)}")
     return v
+
+
+def _shown(v: int) -> str:
+    """An integer as a user typed it, or in short scientific form beyond 20 digits (1e300)."""
+    return str(v) if abs(v) < 10**20 else f"{float(v):.6g}"
 
 
 def as_str(x, name, choices):

@@ -344,7 +344,7 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
 
     if not isinstance(res, IdentificationResult):
         raise ValueError(f"res must be an lptv.IdentificationResult, got {type(res).__name__}")
-    if res.data is None:
+    if res.data is None and not res.experiments:
         raise ValueError("res must carry its data (res.data is None)")
     hz = as_bool(hz, "hz")
     _z(level)

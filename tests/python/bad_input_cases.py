@@ -21,11 +21,14 @@ from pathlib import Path
 from typing import Callable, Optional
 
 import numpy as np
+import lptv
 
 
 NaN, INF = float("nan"), float("inf")
 ROOT = Path(__file__).resolve().parents[2]
-PYTHONPATH = str(ROOT / "python")
+# The child processes import the lptv this process imports (the installed package under `make
+# test`, the source tree with PYTHONPATH=python), never another copy.
+PYTHONPATH = str(Path(lptv.__file__).resolve().parents[1])
 
 
 @dataclass(frozen=True)

@@ -374,8 +374,8 @@ def test_console_script_entry_point():
 @pytest.mark.parametrize("lines, text", [
     ("2-40,2147483647", "lines: row 2147483647 needs lines up to 2147483648 (K = 1 harmonics) "
                         "but the data has lines 0..128"),
-    ("2-40,9223372036854775808", "lines: row 9223372036854775808 is beyond the largest line of any "
-                                 "record (2147483647)"),
+    ("2-40,9223372036854775808", "--lines: '9223372036854775808' goes beyond 2147483647, the largest "
+                                 "value the core takes"),
 ])
 def test_lines_beyond_int_give_one_line_error(lines, text, tmp_path, capsys):
     # 1 / (s + 2) at w0 = 0.1, 4 noisy periods of 256 samples
