@@ -229,13 +229,7 @@ def run(args) -> int:
         for opt in ("na", "nb", "max_iter"):
             integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         positive(args.tol, "--tol")
-        period = None
-        if args.fs is not None or args.dt is not None:
-            period = positive(args.period, "--period")
-            if period is None and positive(args.w0, "--w0") is not None:
-                period = 2 * np.pi / args.w0
-        meas = read_measurements(src, args.periods, fs=args.fs, dt=args.dt, period=period,
-                                 trim=args.trim, skip_periods=args.skip_periods)
+        meas = read_record(src, args)
         if args.discrete and args.ts is not None:
             raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
         if args.discrete and meas.fs is None:
@@ -406,3 +400,15 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
                "The estimated coefficients a_n(t) and b_m(t) over one period (normalised so that "
                "the mean of a_na is 1, unless coefficients were given as known).")
     return rep
+
+
+def read_record(src, args):
+    """The periods of one file as the options say (--periods, --fs / --dt with --period or --w0,
+    --trim, --skip-periods)."""
+    period = None
+    if args.fs is not None or args.dt is not None:
+        period = positive(args.period, "--period")
+        if period is None and positive(args.w0, "--w0") is not None:
+            period = 2 * np.pi / args.w0
+    return read_measurements(src, args.periods, fs=args.fs, dt=args.dt, period=period,
+                             trim=args.trim, skip_periods=args.skip_periods)

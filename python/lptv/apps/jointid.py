@@ -20,9 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import FrequencyData, NumericalError, frozen_poles, frozen_zeros, identify, parameter_table, \
-    plots, read_measurements
-from lptv.apps.fileid import fundamental, parse_counts, parse_known, parse_lines, positive
+from lptv import FrequencyData, NumericalError, frozen_poles, frozen_zeros, identify, parameter_table, plots
+from lptv.apps.fileid import fundamental, parse_counts, parse_known, parse_lines, positive, read_record
 from lptv.apps.report import Report, write_json
 from lptv.measurements import FileError
 
@@ -37,13 +36,7 @@ def _records(args):
     out = []
     for src in args.files:
         try:
-            period = None
-            if args.fs is not None or args.dt is not None:
-                period = positive(args.period, "--period")
-                if period is None and positive(args.w0, "--w0") is not None:
-                    period = 2 * np.pi / args.w0
-            meas = read_measurements(src, args.periods, fs=args.fs, dt=args.dt, period=period,
-                                     trim=args.trim, skip_periods=args.skip_periods)
+            meas = read_record(src, args)
             ts = args.ts
             if args.discrete:
                 if args.ts is not None:
