@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #include <memory>
 #include <type_traits>
@@ -62,6 +63,77 @@ inline kcd crecip(kcd p) {
   return {r * id, -id};
 }
 inline double cabs1(kcd z) { return std::abs(z.real()) + std::abs(z.imag()); }
+
+// Two complex numbers side by side for the kernels' AVX2 instances (below): GCC's generic
+// vectors of four doubles, one AVX register in a function compiled for AVX2. The products are
+// those of cmsub and cmul, each rounded once and combined in the same order (x + (-y) is
+// x - y; no fused multiply-add: lptv is built with -ffp-contract=off), so the AVX2 instances
+// give the same bits as the scalar code (tested). Compiled for SSE2 alone these vectors are
+// slower than the scalar code, so only the AVX2 instances use them.
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define LPTV_AVX2_DISPATCH 1
+#else
+#define LPTV_AVX2_DISPATCH 0
+#endif
+// The vectors live inside the kernels' AVX2 instances (flatten: all inlined), never across a
+// call between differently compiled functions: GCC's note on their ABI does not apply.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4i __attribute__((vector_size(32)));
+#define LPTV_VINLINE inline __attribute__((always_inline))
+LPTV_VINLINE v4d load2(const kcd* p) {
+  v4d v;
+  std::memcpy(&v, static_cast<const void*>(p), sizeof v);
+  return v;
+}
+LPTV_VINLINE void store2(kcd* p, v4d v) { std::memcpy(static_cast<void*>(p), &v, sizeof v); }
+LPTV_VINLINE v4d swap_parts(v4d v) {
+#ifdef __clang__
+  return __builtin_shufflevector(v, v, 1, 0, 3, 2);
+#else
+  return __builtin_shuffle(v, v4i{1, 0, 3, 2});
+#endif
+}
+// x - c y for the complex c and two complex y: c y = (cr y_re - ci y_im, cr y_im + ci y_re).
+LPTV_VINLINE v4d cmsub2(v4d x, kcd c, v4d y) {
+  const v4d cr = {c.real(), c.real(), c.real(), c.real()};
+  const v4d ci = {-c.imag(), c.imag(), -c.imag(), c.imag()};
+  return x - (cr * y + ci * swap_parts(y));
+}
+// c y for two complex y, as cmul(y, c).
+LPTV_VINLINE v4d cmul2(v4d y, kcd c) {
+  const v4d cr = {c.real(), c.real(), c.real(), c.real()};
+  const v4d ci = {-c.imag(), c.imag(), -c.imag(), c.imag()};
+  return cr * y + ci * swap_parts(y);
+}
+
+// Whether the kernels run their AVX2 instances: the processor has AVX2, and neither the
+// environment (LPTV_NO_AVX2 set) nor a test (set_avx2_kernels) said otherwise. The same bits
+// either way.
+inline int& avx2_kernels_setting() {
+  static int setting = [] {
+#if LPTV_AVX2_DISPATCH
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && !std::getenv("LPTV_NO_AVX2") ? 1 : 0;
+#else
+    return 0;
+#endif
+  }();
+  return setting;
+}
+inline bool avx2_kernels() { return avx2_kernels_setting() != 0; }
+// For the tests: false runs the scalar instances; true the AVX2 ones where the processor has
+// them. Returns the previous setting.
+inline bool set_avx2_kernels(bool on) {
+  const bool before = avx2_kernels();
+#if LPTV_AVX2_DISPATCH
+  avx2_kernels_setting() = on && __builtin_cpu_supports("avx2") ? 1 : 0;
+#else
+  (void)on;
+#endif
+  return before;
+}
 
 // The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} (stride 2K+1); the multipliers
 // of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
@@ -132,7 +204,7 @@ struct BandTail {
 // to steps + K - 1 enter): f holds `steps` rows of U, z rows 0..steps-1, the window goes to
 // *tail, and z's rows steps..steps+2K-1 are left to the caller (the solution of the rest,
 // which back_substitute then reads).
-template <int KT, class Source>
+template <int KT, bool V = false, class Source>
 void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_L, kcd* z,
                  int steps = -1, BandTail* tail = nullptr) {
   const int K = KT >= 0 ? KT : Krt;
@@ -177,7 +249,15 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
     f.piv[k] = static_cast<std::uint8_t>(p);
     const kcd* P = wrow(s0);
     kcd* Uk = &f.U[static_cast<size_t>(k) * W];
-    const kcd inv = crecip(P[0]);
+    // 1 / p = conj(p) / |p|^2, and each multiplier r / p as (r conj(p)) / |p|^2: the product
+    // r conj(p) does not wait for the division, which shortens the chain from one pivot to the
+    // next by a complex product (crecip's Smith's method where |p|^2 could overflow or lose
+    // bits to underflow).
+    const double pa = P[0].real(), pb = P[0].imag();
+    const double pm = std::max(std::abs(pa), std::abs(pb));
+    const bool plain = pm > 1e-150 && pm < 1e150;
+    const double id = plain ? 1.0 / (pa * pa + pb * pb) : 0.0;
+    const kcd inv = plain ? kcd(pa * id, -pb * id) : crecip(P[0]);
     Uk[0] = inv;
     for (int j = 1; j < W; ++j) Uk[j] = P[j];
     const kcd* zp = zrow(s0);
@@ -185,13 +265,22 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
     for (int c = 0; c < nz; ++c) zk[c] = zp[c];
     for (int i = 1; i <= m; ++i) {
       kcd* R = wrow(slot(i));
-      const kcd l = cmul(R[0], inv);
+      const kcd r = R[0];
+      const kcd l = plain ? kcd((r.real() * pa + r.imag() * pb) * id, (r.imag() * pa - r.real() * pb) * id)
+                          : cmul(r, inv);
       if (keep_L) f.L[static_cast<size_t>(k) * K + (i - 1)] = l;
       // Eliminate column k and shift the row one column left (the window moves with k).
-      for (int j = 1; j < W; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
-      R[W - 1] = kcd(0.0, 0.0);
       kcd* zr = zrow(slot(i));
-      for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
+      if constexpr (V) {  // W - 1 = 2K entries: pairs
+        for (int j = 1; j < W; j += 2) store2(R + j - 1, cmsub2(load2(R + j), l, load2(P + j)));
+        int c = 0;
+        for (; c + 1 < nz; c += 2) store2(zr + c, cmsub2(load2(zr + c), l, load2(zp + c)));
+        if (c < nz) zr[c] = cmsub(zr[c], l, zp[c]);
+      } else {
+        for (int j = 1; j < W; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
+        for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
+      }
+      R[W - 1] = kcd(0.0, 0.0);
     }
     if (keep_L)  // no rows below the last ones: zero multipliers
       for (int i = m + 1; i <= K; ++i) f.L[static_cast<size_t>(k) * K + (i - 1)] = kcd(0.0, 0.0);
@@ -211,14 +300,22 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
 }
 
 // z (rows 0..n-1 forward-eliminated, 2K zero rows below) := U^-1 z, in place.
-template <int KT>
+template <int KT, bool V = false>
 void back_substitute(const BandFactors& f, int nz, kcd* z) {
   const int K = KT >= 0 ? KT : f.K;
   const int W = 2 * K + 1;
   for (int k = f.n - 1; k >= 0; --k) {
     const kcd* Uk = &f.U[static_cast<size_t>(k) * W];
     kcd* zk = z + static_cast<size_t>(k) * nz;
-    for (int c = 0; c < nz; ++c) {
+    int c = 0;
+    if constexpr (V) {
+      for (; c + 1 < nz; c += 2) {  // two columns at a time, the same operations
+        v4d s = load2(zk + c);
+        for (int j = W - 1; j >= 1; --j) s = cmsub2(s, Uk[j], load2(zk + static_cast<size_t>(j) * nz + c));
+        store2(zk + c, cmul2(s, Uk[0]));
+      }
+    }
+    for (; c < nz; ++c) {
       // The farthest term first: z_{k+1}, which the step before has just written, comes last,
       // so one product and one subtraction separate the steps instead of 2K of them.
       kcd s = zk[c];
@@ -245,6 +342,37 @@ void forward_substitute(const BandFactors& f, int nz, kcd* z) {
   }
 }
 
+// The kernels on the instruction set at hand: the AVX2 instances (the kernel and the row
+// source inlined into one function compiled for AVX2) where avx2_kernels(), the scalar ones
+// otherwise.
+#if LPTV_AVX2_DISPATCH
+template <int KT, class Source>
+__attribute__((target("avx2"), flatten)) void factor_band_avx2(Source& src, int n, int Krt, int nz,
+                                                               BandFactors& f, bool keep_L, kcd* z,
+                                                               int steps, BandTail* tail) {
+  factor_band<KT, true>(src, n, Krt, nz, f, keep_L, z, steps, tail);
+}
+template <int KT>
+__attribute__((target("avx2"), flatten)) void back_substitute_avx2(const BandFactors& f, int nz, kcd* z) {
+  back_substitute<KT, true>(f, nz, z);
+}
+#endif
+template <int KT, class Source>
+void factor_band_best(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_L, kcd* z,
+                      int steps = -1, BandTail* tail = nullptr) {
+#if LPTV_AVX2_DISPATCH
+  if (avx2_kernels()) return factor_band_avx2<KT>(src, n, Krt, nz, f, keep_L, z, steps, tail);
+#endif
+  factor_band<KT>(src, n, Krt, nz, f, keep_L, z, steps, tail);
+}
+template <int KT>
+void back_substitute_best(const BandFactors& f, int nz, kcd* z) {
+#if LPTV_AVX2_DISPATCH
+  if (avx2_kernels()) return back_substitute_avx2<KT>(f, nz, z);
+#endif
+  back_substitute<KT>(f, nz, z);
+}
+
 // Calls f(std::integral_constant<int, K>) for K = 0..7, f(std::integral_constant<int, -1>)
 // (runtime K) above.
 template <class F>
@@ -261,6 +389,8 @@ decltype(auto) dispatch_band(int K, F&& f) {
     default: return f(std::integral_constant<int, -1>());
   }
 }
+
+#pragma GCC diagnostic pop
 
 }  // namespace detail
 }  // namespace lptv

@@ -84,7 +84,7 @@ SmallBandLU::SmallBandLU(int n, int K, const std::vector<cd>& ab,
   std::vector<cd> z(static_cast<size_t>(2 * K));
   try {
     detail::dispatch_band(K, [&](auto kt) {
-      detail::factor_band<decltype(kt)::value>(src, n, K, 0, *f_, true, z.data());
+      detail::factor_band_best<decltype(kt)::value>(src, n, K, 0, *f_, true, z.data());
     });
   } catch (const detail::ZeroPivot& e) {
     throw NumericalError(zero_pivot_message(label(e.column)));
@@ -119,7 +119,7 @@ Eigen::MatrixXcd SmallBandLU::solve(const Eigen::MatrixXcd& rhs) const {
         for (int i = 0; i < n; ++i) z[static_cast<size_t>(i) * nz + c] = rhs(i, c0 + c);
       detail::dispatch_band(K, [&](auto kt) {
         detail::forward_substitute<decltype(kt)::value>(*f_, static_cast<int>(nz), z.data());
-        detail::back_substitute<decltype(kt)::value>(*f_, static_cast<int>(nz), z.data());
+        detail::back_substitute_best<decltype(kt)::value>(*f_, static_cast<int>(nz), z.data());
       });
       for (Eigen::Index c = 0; c < nz; ++c)
         for (int i = 0; i < n; ++i) x(i, c0 + c) = z[static_cast<size_t>(i) * nz + c];

@@ -289,8 +289,8 @@ FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXc
   z.resize(static_cast<size_t>(n + 2 * K) * nz);
   try {
     detail::dispatch_band(K, [&](auto kt) {
-      detail::factor_band<decltype(kt)::value>(src, n, K, nz, f, keep_L, z.data());
-      detail::back_substitute<decltype(kt)::value>(f, nz, z.data());
+      detail::factor_band_best<decltype(kt)::value>(src, n, K, nz, f, keep_L, z.data());
+      detail::back_substitute_best<decltype(kt)::value>(f, nz, z.data());
     });
   } catch (const detail::ZeroPivot& e) {
     zero_pivot(e.column, label);

@@ -20,6 +20,7 @@ namespace {
 // band_entry_ct: the same numbers as build_A's band_entry.
 // Right-hand sides of a row: (B U)_l for each column of U, summed in the full grid's order
 // (U_{-l} = conj(U_l)), then the check's entry m_l exp(j g l).
+template <int NA>  // the order na as a constant (with nb <= na), or -1: any orders
 class FoldedRows {
  public:
   FoldedRows(const Model& m, const Grid& g, const HalfInput& U)
@@ -33,43 +34,58 @@ class FoldedRows {
     int R = 1;
     while (R < 2 * Km_ + 1) R *= 2;
     mask_ = R - 1;
-    t_.resize(static_cast<size_t>(R) * P_);
-    wn_.resize(static_cast<size_t>(R) * (na_ + 1));
+    t_.resize(static_cast<size_t>(R) * P());
     nonzero_.assign(g.L + 1, 0);  // by |line|
     for (int i = 0; i < R_; ++i) nonzero_[i] = !U.row(i).isZero(0.0);
     step_ = std::polar(1.0, -kCheckPhaseStep);  // from line l to line l - 1
-  }
-  int columns() const { return nrhs_ + 1; }
-
-  // A(l, i) for the line l of reversed row r and the lines i of reversed columns base..base+2K.
-  void row(int r, int base, cd* out) {
-    const int l = L_ - r;
-    ensure(l - Km_);
-    // The order as a constant for the common ones, so that the sums unroll (the same sums).
-    switch (na_) {
-      case 1: return row_of(l, base, std::integral_constant<int, 1>(), out);
-      case 2: return row_of(l, base, std::integral_constant<int, 2>(), out);
-      case 3: return row_of(l, base, std::integral_constant<int, 3>(), out);
-      default: return row_of(l, base, na_, out);
+    // The check's row magnitude sum_k sum_n |a_{n,k}| |w0 (l - k)|^n is, for K <= l <= L - K, the
+    // polynomial sum_m p_m l^m with p_m = sum_k sum_{n>=m} |a_{n,k}| w0^n C(n,m) (-k)^(n-m):
+    // na multiply-adds per row instead of (2K+1)(na+1). It differs from the sum by rounding
+    // (a few units in its last places): the check only needs its size.
+    mag_poly_.assign(na_ + 1, 0.0);
+    for (int k = -K_; k <= K_; ++k) {
+      double w0n = 1.0;
+      for (int n = 0; n <= na_; ++n, w0n *= m.w0()) {
+        double binom = 1.0, mk = 1.0;  // C(n, mm) and (-k)^(n-mm), mm from n down
+        for (int mm = n; mm >= 0; --mm) {
+          mag_poly_[mm] += absa_(n, K_ + k) * w0n * binom * mk;
+          binom = binom * mm / (n - mm + 1);
+          mk *= -k;
+        }
+      }
     }
   }
-  template <class Order>
-  void row_of(int l, int base, Order na, cd* out) const {
+  int columns() const { return nrhs_ + 1; }
+  int na() const { return NA >= 0 ? NA : na_; }
+  int P() const { return NA >= 0 ? NA + 1 : P_; }
+
+  // A(l, i) for the line l of reversed row r and the lines i of reversed columns base..base+2K.
+  __attribute__((always_inline)) void row(int r, int base, cd* out) {
+    const int l = L_ - r;
+    ensure(l - Km_);
     const cd* a = aj_.data();
+    const int n = na();
+    if (l + K_ <= L_ && base == L_ - l - K_) {
+      // Rows whose band lies inside the grid (all but the top K): no bounds to test, the
+      // entry j in column line l + K - j.
+      for (int j = 0; j <= 2 * K_; ++j)
+        out[j] = band_entry_ct(a + static_cast<size_t>(j) * (n + 1), t(l + K_ - j), n);
+      return;
+    }
     for (int j = 0; j <= 2 * K_; ++j) {
       const int i = L_ - base - j;
       out[j] = (i < 0 || i > L_ || std::abs(l - i) > K_)
                    ? cd(0.0, 0.0)
-                   : band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (na + 1), t(i), na);
+                   : band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (n + 1), t(i), n);
     }
   }
   // A(l, i) for |l - i| <= K, any line i of the grid (negative lines too).
   cd entry(const cd* a, int l, int i) const {
-    return band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (na_ + 1), t(i), na_);
+    return band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (na() + 1), t(i), na());
   }
   const cd* a() const { return aj_.data(); }
 
-  void rhs(int r, cd* z) {
+  __attribute__((always_inline)) void rhs(int r, cd* z) {
     const int l = L_ - r;
     ensure(l - Km_);
     const cd* b = bj_.data();
@@ -77,6 +93,16 @@ class FoldedRows {
     for (int q = 0; q < nrhs_; ++q) {
       const cd* u = U_.col(q).data();  // line i >= 0; conj(u[-i]) for i < 0
       double re = 0.0, im = 0.0;
+      if (lo >= 0) {  // no conjugate lines in this row
+        for (int c = lo; c <= hi; ++c) {
+          if (!nonzero_[c]) continue;
+          const cd v = band_entry_ct(b + static_cast<size_t>(Kb_ + l - c) * (nb_ + 1), t(c), nb_);
+          re += v.real() * u[c].real() - v.imag() * u[c].imag();
+          im += v.real() * u[c].imag() + v.imag() * u[c].real();
+        }
+        z[q] = cd(re, im);
+        continue;
+      }
       for (int c = lo; c <= hi; ++c) {
         const int a = c < 0 ? -c : c;
         if (!nonzero_[a]) continue;
@@ -87,13 +113,7 @@ class FoldedRows {
       }
       z[q] = cd(re, im);
     }
-    double mag;
-    switch (na_) {
-      case 1: mag = magnitude(l, std::integral_constant<int, 1>()); break;
-      case 2: mag = magnitude(l, std::integral_constant<int, 2>()); break;
-      case 3: mag = magnitude(l, std::integral_constant<int, 3>()); break;
-      default: mag = magnitude(l, na_); break;
-    }
+    const double mag = magnitude(l);
     // exp(j g l) by a recurrence down the lines, re-anchored every 256 lines and at line 0
     // (exactly 1 there: the real part of row 0 is all the corner takes).
     phase_ = (first_ || (l & 255) == 255 || l == 0) ? std::polar(1.0, kCheckPhaseStep * l) : cmul(phase_, step_);
@@ -103,25 +123,30 @@ class FoldedRows {
 
  private:
   // The check's row magnitude: the sum over row l's entries of sum_n |a_{n,k}| |s_c|^n.
-  template <class Order>
-  double magnitude(int l, Order na) const {
+  double magnitude(int l) const {
+    const int na = this->na();
+    if (l >= K_ && l + K_ <= L_) {  // columns l - K..l + K in 0..L: the polynomial (mag_poly_)
+      const double x = l;
+      double v = mag_poly_[na];
+      for (int n = na - 1; n >= 0; --n) v = v * x + mag_poly_[n];
+      return v;
+    }
     const double* absa = absa_.data();
     double mag = 0;
-    for (int c = std::max(-L_, l - K_); c <= std::min(L_, l + K_); ++c)
-      mag += band_entry(absa + static_cast<size_t>(K_ + l - c) * (na + 1), wn(c), static_cast<int>(na));
+    for (int c = std::max(-L_, l - K_); c <= std::min(L_, l + K_); ++c) {
+      const double* c_abs = absa + static_cast<size_t>(K_ + l - c) * (na + 1);
+      const double* tc = t(c);  // |s_c|^n = |w_c^n|
+      double v = 0.0;
+      for (int n = 0; n <= na; ++n) v += c_abs[n] * std::abs(tc[n]);
+      mag += v;
+    }
     return mag;
   }
-  const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P_]; }
-  const double* wn(int c) const { return &wn_[static_cast<size_t>(c & mask_) * (na_ + 1)]; }
+  const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P()]; }
   // Powers of the lines down to c (rows arrive by decreasing line).
   void ensure(int c) {
-    for (; next_ >= c; --next_) {
-      // s = j w, w = w0 l as line_variable forms it; |s|^n = |w^n| (the same products).
-      double* t = &t_[static_cast<size_t>(next_ & mask_) * P_];
-      real_powers(m_.w0() * next_, P_ - 1, t);
-      double* wn = &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)];
-      for (int n = 0; n <= na_; ++n) wn[n] = std::abs(t[n]);
-    }
+    for (; next_ >= c; --next_)  // s = j w, w = w0 l as line_variable forms it
+      real_powers(m_.w0() * next_, P() - 1, &t_[static_cast<size_t>(next_ & mask_) * P()]);
   }
   const Model& m_;
   const HalfInput& U_;
@@ -129,7 +154,7 @@ class FoldedRows {
   Eigen::MatrixXd absa_;
   Eigen::MatrixXcd aj_, bj_;  // the coefficients times j^n (times_j_powers)
   int next_;  // the highest line whose powers are not yet computed
-  std::vector<double> t_, wn_;
+  std::vector<double> t_, mag_poly_;
   std::vector<char> nonzero_;
   cd phase_{1.0, 0.0}, step_;
   bool first_ = true;
@@ -202,9 +227,12 @@ bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full) {
   return true;
 }
 
-FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
+namespace {
+
+template <int NA>
+FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U) {
   const int L = g.L, K = m.ka(), W = 2 * K + 1;
-  FoldedRows src(m, g, U);
+  FoldedRows<NA> src(m, g, U);
   const int nz = src.columns(), nu = nz - 1;
   // Columns Y_L..Y_2K by the band kernel: rows L..K enter.
   const int steps = L - 2 * K + 1;
@@ -214,7 +242,7 @@ FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
   z.resize(static_cast<size_t>(L + 1) * nz);  // rows steps..L: Y_2K-1..Y_0 from the corner
   try {
     dispatch_band(K, [&](auto kt) {
-      factor_band<decltype(kt)::value>(src, L + 1, K, nz, f, false, z.data(), steps, &tail);
+      factor_band_best<decltype(kt)::value>(src, L + 1, K, nz, f, false, z.data(), steps, &tail);
     });
   } catch (const ZeroPivot& e) {
     throw ZeroPivot{L + (L - e.column)};
@@ -246,7 +274,7 @@ FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
     for (int q = 0; q < nz; ++q)
       zi[q] = i == 0 ? cd(y(0, q), 0.0) : cd(y(2 * i - 1, q), y(2 * i, q));
   }
-  dispatch_band(K, [&](auto kt) { back_substitute<decltype(kt)::value>(f, nz, z.data()); });
+  dispatch_band(K, [&](auto kt) { back_substitute_best<decltype(kt)::value>(f, nz, z.data()); });
 
   FoldedSolution out;
   out.Y.resize(L + 1, nu);
@@ -261,6 +289,21 @@ FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
   out.where = L + at;
   out.condition = std::abs(z[static_cast<size_t>(L - at) * nz + nu]);
   return out;
+}
+
+}  // namespace
+
+FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
+  // The orders as constants for the common models, so that the sums unroll (the same sums).
+  if (m.nb() <= m.na()) {
+    switch (m.na()) {
+      case 1: return solve_folded_as<1>(m, g, U);
+      case 2: return solve_folded_as<2>(m, g, U);
+      case 3: return solve_folded_as<3>(m, g, U);
+      default: break;
+    }
+  }
+  return solve_folded_as<-1>(m, g, U);
 }
 
 }  // namespace detail

@@ -7,6 +7,7 @@
 #include "lptv/band_lu.hpp"
 #include "lptv/errors.hpp"
 #include "lptv/fds.hpp"
+#include "band_kernel.hpp"  // detail::set_avx2_kernels (private: the tests' include path)
 
 using lptv::cd;
 
@@ -266,6 +267,53 @@ TEST_CASE("the one-pass route builds build_A's entries, bit for bit", "[band][fd
       const lptv::SmallBandLU lu(g.N, K, band_storage(lptv::build_A(m, g), K), col_label);
       CAPTURE(K, depth);
       REQUIRE(lptv::solve_grid(m, L, U, lptv::Solver::Band).Y == lu.solve(lptv::apply_B(m, g, U)));
+    }
+  }
+}
+
+TEST_CASE("the kernels' AVX2 and scalar instances give the same bits", "[band][fds]") {
+  // The AVX2 instances pair complex numbers in vector registers with the scalar code's
+  // products and sums in the same order (band_kernel.hpp): every result must be identical.
+  // Routes: the half-grid route (real input, one and three inputs: nz = 2 and 4 with the
+  // check), the full-grid route (general input, nz = 3), SmallBandLU (1, 2, 3 and 17 columns,
+  // pivoting bands), for every unrolled bandwidth and the runtime-K code.
+  lptv::detail::set_avx2_kernels(true);
+  if (!lptv::detail::avx2_kernels()) {
+    WARN("this processor has no AVX2: only the scalar instances run here");
+    return;
+  }
+  struct Restore {
+    ~Restore() { lptv::detail::set_avx2_kernels(true); }
+  } restore;
+  auto both = [](const auto& run) {
+    lptv::detail::set_avx2_kernels(false);
+    const auto scalar = run();
+    lptv::detail::set_avx2_kernels(true);
+    const auto avx2 = run();
+    return std::make_pair(scalar, avx2);
+  };
+  for (int K : {1, 2, 3, 4, 5, 6, 7, 8, 10}) {
+    for (double depth : {0.3, 3.0}) {
+      CAPTURE(K, depth);
+      const lptv::Model m = random_model(K, 17 * K + 3, depth);
+      const int L = 50;
+      const lptv::Grid g = lptv::make_grid(m, L);
+      for (int ncol : {1, 3}) {
+        const Eigen::MatrixXcd U = real_input(L, ncol, K + 5);
+        const auto half = both([&] { return lptv::solve_grid(m, L, U, lptv::Solver::Band); });
+        REQUIRE(half.first.Y == half.second.Y);
+        REQUIRE(half.first.condition == half.second.condition);
+      }
+      const Eigen::MatrixXcd Ug = random_rhs(g.N, 2, K + 9);
+      const auto full = both([&] { return lptv::solve_grid(m, L, Ug, lptv::Solver::Band); });
+      REQUIRE(full.first.Y == full.second.Y);
+      REQUIRE(full.first.condition == full.second.condition);
+      const std::vector<cd> ab = random_band(90, K, 41 * K + 1);
+      for (int ncol : {1, 2, 3, 17}) {
+        const Eigen::MatrixXcd b = random_rhs(90, ncol, K + ncol);
+        const auto lu = both([&] { return lptv::SmallBandLU(90, K, ab, col_label).solve(b); });
+        REQUIRE(lu.first == lu.second);
+      }
     }
   }
 }
