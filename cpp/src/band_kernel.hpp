@@ -135,7 +135,10 @@ inline bool set_avx2_kernels(bool on) {
   return before;
 }
 
-// The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} (stride 2K+1); the multipliers
+// The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} / u_kk (stride 2K+1: the
+// row scaled to a unit diagonal, so that the back substitution's step from one unknown to the
+// next is one product and one subtraction, x_k = z_k / u_kk - sum_j (u_kj / u_kk) x_j with
+// the nearest x_{k+1} last, instead of that and a product by 1/u_kk after it); the multipliers
 // of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
 // An array of complex numbers left uninitialised on allocation (std::vector would write zeros
 // over the factors first: one more pass over the largest array of the FDS).
@@ -259,7 +262,11 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
     const double id = plain ? 1.0 / (pa * pa + pb * pb) : 0.0;
     const kcd inv = plain ? kcd(pa * id, -pb * id) : crecip(P[0]);
     Uk[0] = inv;
-    for (int j = 1; j < W; ++j) Uk[j] = P[j];
+    if constexpr (V) {
+      for (int j = 1; j < W; j += 2) store2(Uk + j, cmul2(load2(P + j), inv));
+    } else {
+      for (int j = 1; j < W; ++j) Uk[j] = cmul(P[j], inv);
+    }
     const kcd* zp = zrow(s0);
     kcd* zk = z + static_cast<size_t>(k) * nz;
     for (int c = 0; c < nz; ++c) zk[c] = zp[c];
@@ -310,17 +317,17 @@ void back_substitute(const BandFactors& f, int nz, kcd* z) {
     int c = 0;
     if constexpr (V) {
       for (; c + 1 < nz; c += 2) {  // two columns at a time, the same operations
-        v4d s = load2(zk + c);
+        v4d s = cmul2(load2(zk + c), Uk[0]);
         for (int j = W - 1; j >= 1; --j) s = cmsub2(s, Uk[j], load2(zk + static_cast<size_t>(j) * nz + c));
-        store2(zk + c, cmul2(s, Uk[0]));
+        store2(zk + c, s);
       }
     }
     for (; c < nz; ++c) {
       // The farthest term first: z_{k+1}, which the step before has just written, comes last,
       // so one product and one subtraction separate the steps instead of 2K of them.
-      kcd s = zk[c];
+      kcd s = cmul(zk[c], Uk[0]);
       for (int j = W - 1; j >= 1; --j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
-      zk[c] = cmul(s, Uk[0]);
+      zk[c] = s;
     }
   }
 }

@@ -604,8 +604,7 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     check_grid_size(L, m.kmax());
     const Grid g = make_grid(m, static_cast<int>(L));
     if (half && detail::can_fold(m, g)) {
-      const detail::FoldedSolution s =
-          solve_half(m, g, U.topRows(std::min<Eigen::Index>(U.rows(), g.L + 1)));
+      detail::FoldedSolution s = solve_half(m, g, U.topRows(std::min<Eigen::Index>(U.rows(), g.L + 1)));
       res.solver = Solver::Band;
       const double peak = std::max(max_abs(s.Y), 1e-300);
       double edge = 0;
@@ -613,10 +612,12 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
       const double cond = std::max(1.0, s.condition);
       res.condition = s.condition;
       res.condition_line = g.line_of(s.where);
+      const double bound = 10.0 * cond * edge / peak;
+      if (s.Y.rows() == lines_out + 1) return Run{std::move(s.Y), bound, edge / peak, cond};
       Eigen::MatrixXcd out = Eigen::MatrixXcd::Zero(lines_out + 1, s.Y.cols());
       const int top = std::min(lines_out, g.L);
       out.topRows(top + 1) = s.Y.topRows(top + 1);
-      return Run{std::move(out), 10.0 * cond * edge / peak, edge / peak, cond};
+      return Run{std::move(out), bound, edge / peak, cond};
     }
     const GridSolution s = solve_grid(m, g.L, to_full(g, U), opt.solver);
     res.solver = s.solver;
