@@ -172,6 +172,7 @@ void check_condition(double condition, int where, const std::function<std::strin
 // from the band-row kernel (band_entry_ct: the same numbers as build_A's and band_storage_A's
 // band_entry), and the right-hand sides of each row: (B U)_r for the columns of U (when given), then the conditioning check's entry (check_rhs, the phase by a
 // recurrence re-anchored every 256 rows).
+template <int NA>  // the order na as a constant (with nb <= na), or -1: any orders
 class ModelRows {
  public:
   ModelRows(const Model& m, const Grid& g, const Eigen::MatrixXcd* U)
@@ -183,40 +184,56 @@ class ModelRows {
     int R = 1;
     while (R < 2 * std::max(K_, Kb_) + 1) R *= 2;
     mask_ = R - 1;
-    t_.resize(static_cast<size_t>(R) * P_);
-    wn_.resize(static_cast<size_t>(R) * (na_ + 1));
+    t_.resize(static_cast<size_t>(R) * P());
     nrhs_ = U ? static_cast<int>(U->cols()) : 0;
     if (U) {
       nonzero_.resize(g.N);
       for (int i = 0; i < g.N; ++i) nonzero_[i] = !U->row(i).isZero(0.0);
     }
     step_ = std::polar(1.0, kGoldenAngle);
+    // The check's row magnitude on the lines i >= K and i <= -K as polynomials in |i|
+    // (fds_fold.cpp's FoldedRows: the same numbers for the same line).
+    pos_.assign(na_ + 1, 0.0);
+    neg_.assign(na_ + 1, 0.0);
+    for (int k = -K_; k <= K_; ++k) {
+      double w0n = 1.0;
+      for (int n = 0; n <= na_; ++n, w0n *= m.w0()) {
+        double binom = 1.0, mk = 1.0;  // C(n, mm) and (-k)^(n-mm), mm from n down
+        for (int mm = n; mm >= 0; --mm) {
+          const double v = absa_(n, K_ + k) * w0n * binom;
+          pos_[mm] += v * mk;  // |w0 (i - k)|^n, i >= K
+          // |w0 (i - k)|^n = (w0 (|i| + k))^n for i <= -K: (+k)^(n-mm) = (-1)^(n-mm) mk
+          neg_[mm] += ((n - mm) % 2 ? -v : v) * mk;
+          binom = binom * mm / (n - mm + 1);
+          mk *= -k;
+        }
+      }
+    }
   }
   int columns() const { return nrhs_ + 1; }
+  int na() const { return NA >= 0 ? NA : na_; }
+  int P() const { return NA >= 0 ? NA + 1 : P_; }
 
-  void row(int r, int base, cd* out) {
+  __attribute__((always_inline)) void row(int r, int base, cd* out) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
+    const cd* a = aj_.data();
+    const int n = na();
+    if (base == r - K_ && r + K_ <= g_.N - 1) {
+      // Rows whose band lies inside the grid: no bounds to test, entry j in column r - K + j.
+      for (int j = 0; j <= 2 * K_; ++j)
+        out[j] = detail::band_entry_ct(a + static_cast<size_t>(2 * K_ - j) * (n + 1), t(base + j), n);
+      return;
+    }
     const int lo = std::max(0, r - K_ - base), hi = std::min({2 * K_, r + K_ - base, g_.N - 1 - base});
     for (int j = 0; j < lo; ++j) out[j] = cd(0.0, 0.0);
-    // The order as a constant for the common ones, so that the sums unroll (the same sums).
-    switch (na_) {
-      case 1: entries(r, base, lo, hi, std::integral_constant<int, 1>(), out); break;
-      case 2: entries(r, base, lo, hi, std::integral_constant<int, 2>(), out); break;
-      case 3: entries(r, base, lo, hi, std::integral_constant<int, 3>(), out); break;
-      default: entries(r, base, lo, hi, na_, out); break;
+    for (int j = lo; j <= hi; ++j) {
+      const int c = base + j;
+      out[j] = detail::band_entry_ct(a + static_cast<size_t>(K_ + r - c) * (n + 1), t(c), n);
     }
     for (int j = hi + 1; j <= 2 * K_; ++j) out[j] = cd(0.0, 0.0);
   }
-  template <class Order>
-  void entries(int r, int base, int lo, int hi, Order na, cd* out) const {
-    const cd* a = aj_.data();
-    for (int j = lo; j <= hi; ++j) {
-      const int c = base + j;
-      out[j] = detail::band_entry_ct(a + static_cast<size_t>(K_ + r - c) * (na + 1), t(c), na);
-    }
-  }
 
-  void rhs(int r, cd* z) {
+  __attribute__((always_inline)) void rhs(int r, cd* z) {
     ensure(std::min(g_.N - 1, r + std::max(K_, Kb_)));
     const cd* b = bj_.data();
     const int lo = std::max(0, r - Kb_), hi = std::min(g_.N - 1, r + Kb_);
@@ -231,27 +248,38 @@ class ModelRows {
       }
       z[q] = cd(re, im);
     }
-    const double* absa = absa_.data();
-    double mag = 0;
-    for (int c = std::max(0, r - K_); c <= std::min(g_.N - 1, r + K_); ++c)
-      mag += detail::band_entry(absa + static_cast<size_t>(K_ + r - c) * (na_ + 1), wn(c), na_);
+    const double mag = magnitude(r);
     phase_ = (r & 255) == 0 ? std::polar(1.0, kGoldenAngle * r) : detail::cmul(phase_, step_);
     z[nrhs_] = cd(mag * phase_.real(), mag * phase_.imag());
   }
 
  private:
-  const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P_]; }
-  const double* wn(int c) const { return &wn_[static_cast<size_t>(c & mask_) * (na_ + 1)]; }
+  // Row r's sum over its entries of sum_n |a_{n,k}| |s_c|^n.
+  double magnitude(int r) const {
+    const int na = this->na(), i = g_.line_of(r);
+    if (r - K_ >= 0 && r + K_ <= g_.N - 1 && (i >= K_ || i <= -K_)) {
+      const std::vector<double>& p = i >= K_ ? pos_ : neg_;
+      const double x = std::abs(i);
+      double v = p[na];
+      for (int n = na - 1; n >= 0; --n) v = v * x + p[n];
+      return v;
+    }
+    const double* absa = absa_.data();
+    double mag = 0;
+    for (int c = std::max(0, r - K_); c <= std::min(g_.N - 1, r + K_); ++c) {
+      const double* c_abs = absa + static_cast<size_t>(K_ + r - c) * (na + 1);
+      const double* tc = t(c);  // |s_c|^n = |w_c^n|
+      double v = 0.0;
+      for (int n = 0; n <= na; ++n) v += c_abs[n] * std::abs(tc[n]);
+      mag += v;
+    }
+    return mag;
+  }
+  const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P()]; }
   // Powers of the lines of the columns up to c (columns arrive in increasing order).
   void ensure(int c) {
-    for (; next_ <= c; ++next_) {
-      // s = j w, w = w0 l as line_variable forms it (continuous time: this source serves the
-      // band solver only); |s|^n = |w^n| (the same products).
-      double* t = &t_[static_cast<size_t>(next_ & mask_) * P_];
-      detail::real_powers(m_.w0() * g_.line_of(next_), P_ - 1, t);
-      double* wn = &wn_[static_cast<size_t>(next_ & mask_) * (na_ + 1)];
-      for (int n = 0; n <= na_; ++n) wn[n] = std::abs(t[n]);
-    }
+    for (; next_ <= c; ++next_)  // s = j w, w = w0 l as line_variable forms it
+      detail::real_powers(m_.w0() * g_.line_of(next_), P() - 1, &t_[static_cast<size_t>(next_ & mask_) * P()]);
   }
   const Model& m_;
   const Grid& g_;
@@ -259,7 +287,7 @@ class ModelRows {
   int K_, Kb_, na_, nb_, P_, mask_ = 0, nrhs_ = 0, next_ = 0;
   Eigen::MatrixXd absa_;
   Eigen::MatrixXcd aj_, bj_;  // the coefficients times j^n (detail::times_j_powers)
-  std::vector<double> t_, wn_;
+  std::vector<double> t_, pos_, neg_;
   std::vector<char> nonzero_;
   cd phase_{1.0, 0.0}, step_;
 };
@@ -280,10 +308,11 @@ struct FusedSolve {
   int where = 0;
 };
 
-FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXcd* U,
+template <int NA>
+FusedSolve fused_band_solve_as(const Model& m, const Grid& g, const Eigen::MatrixXcd* U,
                             detail::BandFactors& f, bool keep_L,
                             const std::function<std::string(int)>& label) {
-  ModelRows src(m, g, U);
+  ModelRows<NA> src(m, g, U);
   const int n = g.N, K = m.ka(), nz = src.columns();
   detail::RawArray z;
   z.resize(static_cast<size_t>(n + 2 * K) * nz);
@@ -307,6 +336,21 @@ FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXc
   out.condition = std::abs(z[static_cast<size_t>(out.where) * nz + nu]);
   if (!out.Y.allFinite()) throw NumericalError("band solve produced NaN or inf");
   return out;
+}
+
+FusedSolve fused_band_solve(const Model& m, const Grid& g, const Eigen::MatrixXcd* U,
+                            detail::BandFactors& f, bool keep_L,
+                            const std::function<std::string(int)>& label) {
+  // The orders as constants for the common models, so that the sums unroll (the same sums).
+  if (m.nb() <= m.na()) {
+    switch (m.na()) {
+      case 1: return fused_band_solve_as<1>(m, g, U, f, keep_L, label);
+      case 2: return fused_band_solve_as<2>(m, g, U, f, keep_L, label);
+      case 3: return fused_band_solve_as<3>(m, g, U, f, keep_L, label);
+      default: break;
+    }
+  }
+  return fused_band_solve_as<-1>(m, g, U, f, keep_L, label);
 }
 
 bool use_small_band(const Model& m) { return m.ka() <= SmallBandLU::kMaxK; }
