@@ -1,6 +1,5 @@
 #include "fds_fold.hpp"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
@@ -191,13 +190,39 @@ class CornerSystem {
     add(im_, 2 * i - 1, c.imag()), add(im_, 2 * i, -c.real());
   }
   // Y_i for column q; throws ZeroPivot with the line (the caller maps it) of an exactly
-  // singular system.
-  Eigen::MatrixXd solve() const {
-    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(M_);
-    const Eigen::VectorXd d = lu.matrixLU().diagonal();
-    for (int c = 0; c < n_; ++c)
-      if (d[c] == 0.0) throw ZeroPivot{(c + 1) / 2};
-    return lu.solve(b_);
+  // singular system. Gaussian elimination with partial pivoting (the largest |entry| of the
+  // column, the first of equals) written out for these few unknowns (4K - 1): a general dense
+  // LU costs more in its set-up than in its arithmetic here.
+  Eigen::MatrixXd solve() {
+    Eigen::MatrixXd& M = M_;
+    Eigen::MatrixXd& b = b_;
+    std::vector<int> at(n_);  // the unknown's original column for each pivot position
+    for (int c = 0; c < n_; ++c) {
+      int p = c;
+      double best = std::abs(M(c, c));
+      for (int r = c + 1; r < n_; ++r)
+        if (std::abs(M(r, c)) > best) best = std::abs(M(r, c)), p = r;
+      if (best == 0.0) throw ZeroPivot{(c + 1) / 2};
+      if (p != c) {
+        M.row(p).swap(M.row(c));
+        b.row(p).swap(b.row(c));
+      }
+      const double inv = 1.0 / M(c, c);
+      for (int r = c + 1; r < n_; ++r) {
+        const double l = M(r, c) * inv;
+        if (l == 0.0) continue;
+        for (int j = c + 1; j < n_; ++j) M(r, j) -= l * M(c, j);
+        for (int q = 0; q < nz_; ++q) b(r, q) -= l * b(c, q);
+      }
+    }
+    for (int c = n_ - 1; c >= 0; --c) {
+      for (int q = 0; q < nz_; ++q) {
+        double v = b(c, q);
+        for (int j = c + 1; j < n_; ++j) v -= M(c, j) * b(j, q);
+        b(c, q) = v / M(c, c);
+      }
+    }
+    return b;
   }
 
  private:
