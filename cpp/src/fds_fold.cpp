@@ -164,7 +164,8 @@ class FoldedRows {
 // imaginary part vanishes for a real Y_0), the others two.
 class CornerSystem {
  public:
-  CornerSystem(int K, int nz) : n_(4 * K - 1), nz_(nz), M_(Eigen::MatrixXd::Zero(n_, n_)), b_(n_, nz) {}
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  CornerSystem(int K, int nz) : n_(4 * K - 1), nz_(nz), M_(Rows::Zero(n_, n_)), b_(n_, nz) {}
   // Adds the complex equation sum_i d_i Y_i + sum_i c_i conj(Y_i) = z to the next rows;
   // real_only: its real part alone.
   void begin(const cd* z, bool real_only) {
@@ -193,10 +194,10 @@ class CornerSystem {
   // singular system. Gaussian elimination with partial pivoting (the largest |entry| of the
   // column, the first of equals) written out for these few unknowns (4K - 1): a general dense
   // LU costs more in its set-up than in its arithmetic here.
-  Eigen::MatrixXd solve() {
-    Eigen::MatrixXd& M = M_;
-    Eigen::MatrixXd& b = b_;
-    std::vector<int> at(n_);  // the unknown's original column for each pivot position
+  const Rows& solve() {
+    Rows& M = M_;
+    Rows& b = b_;
+    std::vector<double> inv(n_);
     for (int c = 0; c < n_; ++c) {
       int p = c;
       double best = std::abs(M(c, c));
@@ -207,9 +208,9 @@ class CornerSystem {
         M.row(p).swap(M.row(c));
         b.row(p).swap(b.row(c));
       }
-      const double inv = 1.0 / M(c, c);
+      inv[c] = 1.0 / M(c, c);
       for (int r = c + 1; r < n_; ++r) {
-        const double l = M(r, c) * inv;
+        const double l = M(r, c) * inv[c];
         if (l == 0.0) continue;
         for (int j = c + 1; j < n_; ++j) M(r, j) -= l * M(c, j);
         for (int q = 0; q < nz_; ++q) b(r, q) -= l * b(c, q);
@@ -219,7 +220,7 @@ class CornerSystem {
       for (int q = 0; q < nz_; ++q) {
         double v = b(c, q);
         for (int j = c + 1; j < n_; ++j) v -= M(c, j) * b(j, q);
-        b(c, q) = v / M(c, c);
+        b(c, q) = v * inv[c];
       }
     }
     return b;
@@ -230,7 +231,7 @@ class CornerSystem {
     if (row >= 0) M_(row, col) += v;
   }
   int n_, nz_, next_ = 0, re_ = 0, im_ = 0;
-  Eigen::MatrixXd M_, b_;
+  Rows M_, b_;
 };
 
 }  // namespace
@@ -288,7 +289,7 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
       else cs.conjugate(-i, v);
     }
   }
-  Eigen::MatrixXd y;
+  CornerSystem::Rows y;
   try {
     y = cs.solve();
   } catch (const ZeroPivot& e) {
