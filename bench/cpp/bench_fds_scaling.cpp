@@ -58,6 +58,9 @@ struct Measurement {
   // The same route for a real input (U_{-l} = conj(U_l), as simulate passes it): the half-grid
   // route (cpp/src/fds_fold.hpp); its difference from Fds::solve_full on that input.
   double real = -1, real_diff = 0;
+  // lptv::simulate itself on that input (one-sided in and out, guard 0: the grid -L..L), its
+  // difference from the real-input route's lines 0..L.
+  double sim = -1, sim_diff = 0;
   long rss_base_kb = 0, rss_peak_kb = 0;
   double residual = 0;   // |A Y - B U| / (|A| |Y| + |B U|), max norms
   double condition = 0;  // Fds::condition()
@@ -193,6 +196,13 @@ Measurement measure(const lptv::Model& model, int L, Route route) {
     const Eigen::MatrixXcd Yr_ref = lptv::Fds(model, L, lptv::Solver::Band).solve_full(Ur);
     repeat([&] { timed(&m.real, [&] { Yf = lptv::solve_grid(model, L, Ur, lptv::Solver::Band).Y; }); });
     m.real_diff = (Yf - Yr_ref).cwiseAbs().maxCoeff() / Yr_ref.cwiseAbs().maxCoeff();
+    const Eigen::MatrixXcd U1 = Ur.bottomRows(L + 1);  // lines 0..L
+    lptv::SimulateOptions so;
+    so.guard = 0;
+    so.lines_out = L;
+    Eigen::MatrixXcd Ys;
+    repeat([&] { timed(&m.sim, [&] { Ys = lptv::simulate(model, U1, so).Y; }); });
+    m.sim_diff = (Ys - Yr_ref.bottomRows(L + 1)).cwiseAbs().maxCoeff() / Yr_ref.cwiseAbs().maxCoeff();
     const size_t bytes = static_cast<size_t>(kFloorBytes) * g.N / 2;
     std::vector<char> src(bytes, 1), dst(bytes, 0);
     repeat([&] { timed(&m.copy, [&] { std::memcpy(dst.data(), src.data(), bytes); }); });
@@ -423,16 +433,23 @@ int main(int argc, char** argv) {
               kFloorBytes, kFloorBytes / 2);
   std::printf("(real input: U_{-l} = conj(U_l), as simulate passes it: the half-grid route, which "
               "moves at least half those bytes, copy/2)\n");
-  std::printf("%10s %10s %10s %8s %10s | %10s %10s %8s %10s\n", "lines", "one-pass", "copy", "ratio",
-              "vs route", "real input", "copy/2", "ratio", "vs Fds");
-  double flo = 1e300, fhi = 0, rlo = 1e300, rhi = 0;
+  std::printf("(simulate: lptv::simulate on that input's lines 0..L, guard 0, lines_out L: the same grid, one-sided in and out)\n");
+  std::printf("%10s %10s %10s %8s %10s | %10s %10s %8s %10s | %10s %8s\n", "lines", "one-pass", "copy", "ratio",
+              "vs route", "real input", "copy/2", "ratio", "vs Fds", "simulate", "vs Fds");
+  double flo = 1e300, fhi = 0, rlo = 1e300, rhi = 0, slo = 1e300, shi = 0;
   for (const Row& r : rows) {
     const Measurement& m = r.m[kBand];
     if (!m.ok || m.fused < 0) continue;
     const double n = double(r.n);
-    std::printf("%10ld %10.1f %10.1f %8.2f %10.1e | %10.1f %10.1f %8.2f %10.1e\n", r.n,
+    std::printf("%10ld %10.1f %10.1f %8.2f %10.1e | %10.1f %10.1f %8.2f %10.1e | %10.1f %8.1e\n", r.n,
                 1e9 * m.fused / n, 1e9 * m.copy / n, m.fused / m.copy, m.fused_diff, 1e9 * m.real / n,
-                0.5e9 * m.copy / n, m.real / (0.5 * m.copy), m.real_diff);
+                0.5e9 * m.copy / n, m.real / (0.5 * m.copy), m.real_diff, 1e9 * m.sim / n, m.sim_diff);
+    slo = std::min(slo, m.sim / n);
+    shi = std::max(shi, m.sim / n);
+    if (!(m.sim_diff <= 1e-12)) {
+      std::fprintf(stderr, "simulate disagrees with Fds at n = %ld: %.1e\n", r.n, m.sim_diff);
+      failed = true;
+    }
     flo = std::min(flo, m.fused / n);
     fhi = std::max(fhi, m.fused / n);
     rlo = std::min(rlo, m.real / n);
@@ -446,7 +463,9 @@ int main(int argc, char** argv) {
       failed = true;
     }
   }
-  if (fhi > 0) std::printf("one-pass spread (max / min): %.2fx, real input %.2fx\n", fhi / flo, rhi / rlo);
+  if (fhi > 0)
+    std::printf("one-pass spread (max / min): %.2fx, real input %.2fx, simulate %.2fx\n", fhi / flo, rhi / rlo,
+                shi / slo);
 
   std::printf("\nspread of the time per line (max / min over the sizes that ran; goal: within 2x "
               "from 10^3 to 10^7):");

@@ -140,6 +140,11 @@ inline bool set_avx2_kernels(bool on) {
 // next is one product and one subtraction, x_k = z_k / u_kk - sum_j (u_kj / u_kk) x_j with
 // the nearest x_{k+1} last, instead of that and a product by 1/u_kk after it); the multipliers
 // of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
+// Row k of U has entries in columns k..k+K unless pivoting brought a row reaching further into
+// the pivot position (then up to k+2K): U holds entries 0..K of every row (stride K+1), a
+// long row has kLongRow set in piv[k] and its entries K+1..2K in Ulong, in the order of k.
+// Without pivoting U is then half the bytes of the full width, and the back substitution
+// skips the exact zeros it would otherwise subtract (the same result: s - 0 z = s).
 // An array of complex numbers left uninitialised on allocation (std::vector would write zeros
 // over the factors first: one more pass over the largest array of the FDS).
 // Large arrays ask Linux for transparent huge pages: at 10^7 lines the first touches of 4 KiB
@@ -179,10 +184,13 @@ class RawArray {
 };
 
 struct BandFactors {
+  static constexpr std::uint8_t kLongRow = 0x80;  // in piv; p <= K <= SmallBandLU::kMaxK < 128
   int n = 0, K = 0;
   RawArray U;
+  std::vector<kcd> Ulong;
   RawArray L;  // empty when the factors are used for the right-hand sides given only
   std::vector<std::uint8_t> piv;
+  int pivot(int k) const { return piv[k] & ~kLongRow & 0xff; }
 };
 
 // Thrown through the kernel as the column of the first exactly zero pivot (the caller names it).
@@ -216,7 +224,8 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
   if (!partial) steps = n;
   f.n = steps;
   f.K = K;
-  f.U.resize(static_cast<size_t>(steps) * W);
+  f.U.resize(static_cast<size_t>(steps) * (K + 1));
+  f.Ulong.clear();
   f.piv.resize(steps);
   f.L.resize(keep_L ? static_cast<size_t>(steps) * std::max(K, 1) : 0);
   std::vector<kcd> win(static_cast<size_t>(K + 1) * W), zw(static_cast<size_t>(K + 1) * std::max(nz, 1));
@@ -249,9 +258,11 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
       std::swap_ranges(wrow(s0), wrow(s0) + W, wrow(slot(p)));
       std::swap_ranges(zrow(s0), zrow(s0) + nz, zrow(slot(p)));
     }
-    f.piv[k] = static_cast<std::uint8_t>(p);
     const kcd* P = wrow(s0);
-    kcd* Uk = &f.U[static_cast<size_t>(k) * W];
+    bool long_row = false;
+    for (int j = K + 1; j < W; ++j) long_row |= P[j] != kcd(0.0, 0.0);
+    f.piv[k] = static_cast<std::uint8_t>(p) | (long_row ? BandFactors::kLongRow : 0);
+    kcd* Uk = &f.U[static_cast<size_t>(k) * (K + 1)];
     // 1 / p = conj(p) / |p|^2, and each multiplier r / p as (r conj(p)) / |p|^2: the product
     // r conj(p) does not wait for the division, which shortens the chain from one pivot to the
     // next by a complex product (crecip's Smith's method where |p|^2 could overflow or lose
@@ -262,10 +273,18 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
     const double id = plain ? 1.0 / (pa * pa + pb * pb) : 0.0;
     const kcd inv = plain ? kcd(pa * id, -pb * id) : crecip(P[0]);
     Uk[0] = inv;
-    if constexpr (V) {
-      for (int j = 1; j < W; j += 2) store2(Uk + j, cmul2(load2(P + j), inv));
-    } else {
-      for (int j = 1; j < W; ++j) Uk[j] = cmul(P[j], inv);
+    // out[j] = P[from + j] inv, j < count.
+    auto scaled = [&](kcd* out, int from, int count) {
+      int j = 0;
+      if constexpr (V)
+        for (; j + 1 < count; j += 2) store2(out + j, cmul2(load2(P + from + j), inv));
+      for (; j < count; ++j) out[j] = cmul(P[from + j], inv);
+    };
+    scaled(Uk + 1, 1, K);
+    if (long_row) {
+      const size_t at = f.Ulong.size();
+      f.Ulong.resize(at + K);
+      scaled(&f.Ulong[at], K + 1, K);
     }
     const kcd* zp = zrow(s0);
     kcd* zk = z + static_cast<size_t>(k) * nz;
@@ -310,23 +329,29 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
 template <int KT, bool V = false>
 void back_substitute(const BandFactors& f, int nz, kcd* z) {
   const int K = KT >= 0 ? KT : f.K;
-  const int W = 2 * K + 1;
+  size_t next_long = f.Ulong.size();  // long rows are met in the reverse of their order
   for (int k = f.n - 1; k >= 0; --k) {
-    const kcd* Uk = &f.U[static_cast<size_t>(k) * W];
+    const kcd* Uk = &f.U[static_cast<size_t>(k) * (K + 1)];
+    const bool long_row = f.piv[k] & BandFactors::kLongRow;
+    const kcd* Ul = long_row ? &f.Ulong[next_long -= K] : nullptr;  // entries K+1..2K
     kcd* zk = z + static_cast<size_t>(k) * nz;
+    // The farthest term first: z_{k+1}, which the step before has just written, comes last,
+    // so one product and one subtraction separate the steps instead of 2K of them.
     int c = 0;
     if constexpr (V) {
       for (; c + 1 < nz; c += 2) {  // two columns at a time, the same operations
         v4d s = cmul2(load2(zk + c), Uk[0]);
-        for (int j = W - 1; j >= 1; --j) s = cmsub2(s, Uk[j], load2(zk + static_cast<size_t>(j) * nz + c));
+        if (long_row)
+          for (int j = 2 * K; j > K; --j) s = cmsub2(s, Ul[j - K - 1], load2(zk + static_cast<size_t>(j) * nz + c));
+        for (int j = K; j >= 1; --j) s = cmsub2(s, Uk[j], load2(zk + static_cast<size_t>(j) * nz + c));
         store2(zk + c, s);
       }
     }
     for (; c < nz; ++c) {
-      // The farthest term first: z_{k+1}, which the step before has just written, comes last,
-      // so one product and one subtraction separate the steps instead of 2K of them.
       kcd s = cmul(zk[c], Uk[0]);
-      for (int j = W - 1; j >= 1; --j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
+      if (long_row)
+        for (int j = 2 * K; j > K; --j) s = cmsub(s, Ul[j - K - 1], zk[static_cast<size_t>(j) * nz + c]);
+      for (int j = K; j >= 1; --j) s = cmsub(s, Uk[j], zk[static_cast<size_t>(j) * nz + c]);
       zk[c] = s;
     }
   }
@@ -338,7 +363,7 @@ void forward_substitute(const BandFactors& f, int nz, kcd* z) {
   const int K = KT >= 0 ? KT : f.K;
   for (int k = 0; k < f.n; ++k) {
     kcd* zk = z + static_cast<size_t>(k) * nz;
-    const int p = f.piv[k];
+    const int p = f.pivot(k);
     if (p) std::swap_ranges(zk, zk + nz, zk + static_cast<size_t>(p) * nz);
     const kcd* Lk = &f.L[static_cast<size_t>(k) * K];
     for (int i = 1; i <= K; ++i) {

@@ -97,7 +97,10 @@ SmallBandLU::SmallBandLU(SmallBandLU&&) noexcept = default;
 SmallBandLU& SmallBandLU::operator=(SmallBandLU&&) noexcept = default;
 int SmallBandLU::n() const { return f_->n; }
 int SmallBandLU::K() const { return f_->K; }
-int SmallBandLU::pivot(int k) const { return f_->piv.at(k); }
+int SmallBandLU::pivot(int k) const {
+  f_->piv.at(k);  // the range check
+  return f_->pivot(k);
+}
 
 Eigen::MatrixXcd SmallBandLU::solve(const Eigen::MatrixXcd& rhs) const {
   const int n = f_->n, K = f_->K;
