@@ -135,8 +135,8 @@ inline bool set_avx2_kernels(bool on) {
   return before;
 }
 
-// The factors: row k of U as 1/u_kk followed by u_{k,k+1..k+2K} / u_kk (stride 2K+1: the
-// row scaled to a unit diagonal, so that the back substitution's step from one unknown to the
+// The factors: row k of U as 1/u_kk followed by u_{k,k+1..} / u_kk (the row scaled to a unit
+// diagonal, so that the back substitution's step from one unknown to the
 // next is one product and one subtraction, x_k = z_k / u_kk - sum_j (u_kj / u_kk) x_j with
 // the nearest x_{k+1} last, instead of that and a product by 1/u_kk after it); the multipliers
 // of step k (stride K; zero below the last row); piv[k] = p when rows k and k+p were swapped.
