@@ -361,15 +361,16 @@ std::function<std::string(int)> line_label(const Grid& g) {
 
 // The half-grid route (fds_fold.hpp) for a real input given by its lines 0.., with the
 // refusals of the full-grid one.
-detail::FoldedSolution solve_half(const Model& m, const Grid& g, const detail::HalfInput& U) {
+detail::FoldedSolution solve_half(const Model& m, const Grid& g, const detail::HalfInput& U,
+                                  Eigen::MatrixXcd* full = nullptr) {
   const auto label = line_label(g);
   detail::FoldedSolution r;
   try {
-    r = detail::solve_folded(m, g, U);
+    r = detail::solve_folded(m, g, U, full);
   } catch (const detail::ZeroPivot& e) {
     zero_pivot(e.column, label);
   }
-  if (!r.Y.allFinite()) throw NumericalError("band solve produced NaN or inf");
+  if (!(full ? full->allFinite() : r.Y.allFinite())) throw NumericalError("band solve produced NaN or inf");
   check_condition(r.condition, r.where, label);
   return r;
 }
@@ -423,10 +424,8 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
     const int L = out.grid.L;
     if (detail::can_fold(m, out.grid) && detail::real_input(out.grid, U_full)) {
       // A real input: half the grid (fds_fold.hpp).
-      const detail::FoldedSolution r = solve_half(m, out.grid, U_full.middleRows(L, L + 1));
-      out.Y.resize(out.grid.N, r.Y.cols());
-      out.Y.middleRows(L, L + 1) = r.Y;
-      out.Y.topRows(L) = r.Y.bottomRows(L).colwise().reverse().conjugate();
+      out.Y.resize(out.grid.N, U_full.cols());
+      const detail::FoldedSolution r = solve_half(m, out.grid, U_full.middleRows(L, L + 1), &out.Y);
       out.condition = r.condition;
       out.condition_line = out.grid.line_of(r.where);  // a line >= 0 (|x| is symmetric)
       return out;

@@ -256,7 +256,7 @@ bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full) {
 namespace {
 
 template <int NA>
-FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U) {
+FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U, Eigen::MatrixXcd* full) {
   const int L = g.L, K = m.ka(), W = 2 * K + 1;
   FoldedRows<NA> src(m, g, U);
   const int nz = src.columns(), nu = nz - 1;
@@ -303,12 +303,16 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
   dispatch_band(K, [&](auto kt) { back_substitute_best<decltype(kt)::value>(f, nz, z.data()); });
 
   FoldedSolution out;
-  out.Y.resize(L + 1, nu);
+  if (!full) out.Y.resize(L + 1, nu);
   double best = -1.0;
   int at = 0;
   for (int l = 0; l <= L; ++l) {
     const cd* zl = &z[static_cast<size_t>(L - l) * nz];
-    for (int q = 0; q < nu; ++q) out.Y(l, q) = zl[q];
+    if (full) {
+      for (int q = 0; q < nu; ++q) (*full)(L - l, q) = std::conj(zl[q]), (*full)(L + l, q) = zl[q];
+    } else {
+      for (int q = 0; q < nu; ++q) out.Y(l, q) = zl[q];
+    }
     const double a = std::norm(zl[nu]);
     if (a > best || !(a == a)) best = a, at = l;
   }
@@ -319,17 +323,17 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
 
 }  // namespace
 
-FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U) {
+FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U, Eigen::MatrixXcd* full) {
   // The orders as constants for the common models, so that the sums unroll (the same sums).
   if (m.nb() <= m.na()) {
     switch (m.na()) {
-      case 1: return solve_folded_as<1>(m, g, U);
-      case 2: return solve_folded_as<2>(m, g, U);
-      case 3: return solve_folded_as<3>(m, g, U);
+      case 1: return solve_folded_as<1>(m, g, U, full);
+      case 2: return solve_folded_as<2>(m, g, U, full);
+      case 3: return solve_folded_as<3>(m, g, U, full);
       default: break;
     }
   }
-  return solve_folded_as<-1>(m, g, U);
+  return solve_folded_as<-1>(m, g, U, full);
 }
 
 }  // namespace detail

@@ -38,14 +38,16 @@ bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full);
 using HalfInput = Eigen::Ref<const Eigen::MatrixXcd>;
 
 struct FoldedSolution {
-  Eigen::MatrixXcd Y;      // lines 0..L (the negative lines are their conjugates)
+  Eigen::MatrixXcd Y;      // lines 0..L (the negative lines are their conjugates); empty with `full`
   double condition = 0.0;  // max |x| of the check's solution
   int where = 0;           // its grid index (a line >= 0)
 };
 
 // Y = A^-1 B U on the grid with the check. Throws ZeroPivot (band_kernel.hpp) with the grid
-// index of the first exactly zero pivot.
-FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U);
+// index of the first exactly zero pivot. With `full` (g.N x U.cols(), sized by the caller) the
+// solution goes there on the whole grid, grid index L + l for line l, instead of into Y.
+FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U,
+                            Eigen::MatrixXcd* full = nullptr);
 
 }  // namespace detail
 }  // namespace lptv
