@@ -177,7 +177,7 @@ class ModelRows {
  public:
   ModelRows(const Model& m, const Grid& g, const Eigen::MatrixXcd* U)
       : m_(m), g_(g), U_(U), K_(m.ka()), Kb_(m.kb()), na_(m.na()), nb_(m.nb()),
-        P_(std::max(na_, nb_) + 1), absa_(m.a().cwiseAbs()), aj_(m.a().rows(), m.a().cols()),
+        P_(std::max(na_, nb_) + 1), mag_(m.a().cwiseAbs(), m.w0()), aj_(m.a().rows(), m.a().cols()),
         bj_(m.b().rows(), m.b().cols()) {
     for (Eigen::Index k = 0; k < aj_.cols(); ++k) detail::times_j_powers(m.a().col(k).data(), na_, aj_.col(k).data());
     for (Eigen::Index k = 0; k < bj_.cols(); ++k) detail::times_j_powers(m.b().col(k).data(), nb_, bj_.col(k).data());
@@ -191,24 +191,6 @@ class ModelRows {
       for (int i = 0; i < g.N; ++i) nonzero_[i] = !U->row(i).isZero(0.0);
     }
     step_ = std::polar(1.0, kGoldenAngle);
-    // The check's row magnitude on the lines i >= K and i <= -K as polynomials in |i|
-    // (fds_fold.cpp's FoldedRows: the same numbers for the same line).
-    pos_.assign(na_ + 1, 0.0);
-    neg_.assign(na_ + 1, 0.0);
-    for (int k = -K_; k <= K_; ++k) {
-      double w0n = 1.0;
-      for (int n = 0; n <= na_; ++n, w0n *= m.w0()) {
-        double binom = 1.0, mk = 1.0;  // C(n, mm) and (-k)^(n-mm), mm from n down
-        for (int mm = n; mm >= 0; --mm) {
-          const double v = absa_(n, K_ + k) * w0n * binom;
-          pos_[mm] += v * mk;  // |w0 (i - k)|^n, i >= K
-          // |w0 (i - k)|^n = (w0 (|i| + k))^n for i <= -K: (+k)^(n-mm) = (-1)^(n-mm) mk
-          neg_[mm] += ((n - mm) % 2 ? -v : v) * mk;
-          binom = binom * mm / (n - mm + 1);
-          mk *= -k;
-        }
-      }
-    }
   }
   int columns() const { return nrhs_ + 1; }
   int na() const { return NA >= 0 ? NA : na_; }
@@ -256,24 +238,9 @@ class ModelRows {
  private:
   // Row r's sum over its entries of sum_n |a_{n,k}| |s_c|^n.
   double magnitude(int r) const {
-    const int na = this->na(), i = g_.line_of(r);
-    if (r - K_ >= 0 && r + K_ <= g_.N - 1 && (i >= K_ || i <= -K_)) {
-      const std::vector<double>& p = i >= K_ ? pos_ : neg_;
-      const double x = std::abs(i);
-      double v = p[na];
-      for (int n = na - 1; n >= 0; --n) v = v * x + p[n];
-      return v;
-    }
-    const double* absa = absa_.data();
-    double mag = 0;
-    for (int c = std::max(0, r - K_); c <= std::min(g_.N - 1, r + K_); ++c) {
-      const double* c_abs = absa + static_cast<size_t>(K_ + r - c) * (na + 1);
-      const double* tc = t(c);  // |s_c|^n = |w_c^n|
-      double v = 0.0;
-      for (int n = 0; n <= na; ++n) v += c_abs[n] * std::abs(tc[n]);
-      mag += v;
-    }
-    return mag;
+    const int i = g_.line_of(r);
+    if (r - K_ >= 0 && r + K_ <= g_.N - 1 && (i >= K_ || i <= -K_)) return mag_.far(i, na());
+    return mag_.direct(r, std::max(0, r - K_), std::min(g_.N - 1, r + K_), na(), [this](int c) { return t(c); });
   }
   const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P()]; }
   // Powers of the lines of the columns up to c (columns arrive in increasing order).
@@ -285,9 +252,9 @@ class ModelRows {
   const Grid& g_;
   const Eigen::MatrixXcd* U_;
   int K_, Kb_, na_, nb_, P_, mask_ = 0, nrhs_ = 0, next_ = 0;
-  Eigen::MatrixXd absa_;
+  detail::CheckMagnitude mag_;
   Eigen::MatrixXcd aj_, bj_;  // the coefficients times j^n (detail::times_j_powers)
-  std::vector<double> t_, pos_, neg_;
+  std::vector<double> t_;
   std::vector<char> nonzero_;
   cd phase_{1.0, 0.0}, step_;
 };

@@ -26,7 +26,7 @@ class FoldedRows {
       : m_(m), U_(U), R_(static_cast<int>(std::min<Eigen::Index>(U.rows(), g.L + 1))), L_(g.L),
         K_(m.ka()), Kb_(m.kb()), Km_(std::max(K_, Kb_)), na_(m.na()), nb_(m.nb()),
         P_(std::max(na_, nb_) + 1), nrhs_(static_cast<int>(U.cols())),
-        absa_(m.a().cwiseAbs()), aj_(m.a().rows(), m.a().cols()), bj_(m.b().rows(), m.b().cols()),
+        mag_(m.a().cwiseAbs(), m.w0()), aj_(m.a().rows(), m.a().cols()), bj_(m.b().rows(), m.b().cols()),
         next_(g.L) {
     for (Eigen::Index k = 0; k < aj_.cols(); ++k) times_j_powers(m.a().col(k).data(), na_, aj_.col(k).data());
     for (Eigen::Index k = 0; k < bj_.cols(); ++k) times_j_powers(m.b().col(k).data(), nb_, bj_.col(k).data());
@@ -37,22 +37,6 @@ class FoldedRows {
     nonzero_.assign(g.L + 1, 0);  // by |line|
     for (int i = 0; i < R_; ++i) nonzero_[i] = !U.row(i).isZero(0.0);
     step_ = std::polar(1.0, -kCheckPhaseStep);  // from line l to line l - 1
-    // The check's row magnitude sum_k sum_n |a_{n,k}| |w0 (l - k)|^n is, for K <= l <= L - K, the
-    // polynomial sum_m p_m l^m with p_m = sum_k sum_{n>=m} |a_{n,k}| w0^n C(n,m) (-k)^(n-m):
-    // na multiply-adds per row instead of (2K+1)(na+1). It differs from the sum by rounding
-    // (a few units in its last places): the check only needs its size.
-    mag_poly_.assign(na_ + 1, 0.0);
-    for (int k = -K_; k <= K_; ++k) {
-      double w0n = 1.0;
-      for (int n = 0; n <= na_; ++n, w0n *= m.w0()) {
-        double binom = 1.0, mk = 1.0;  // C(n, mm) and (-k)^(n-mm), mm from n down
-        for (int mm = n; mm >= 0; --mm) {
-          mag_poly_[mm] += absa_(n, K_ + k) * w0n * binom * mk;
-          binom = binom * mm / (n - mm + 1);
-          mk *= -k;
-        }
-      }
-    }
   }
   int columns() const { return nrhs_ + 1; }
   int na() const { return NA >= 0 ? NA : na_; }
@@ -123,23 +107,8 @@ class FoldedRows {
  private:
   // The check's row magnitude: the sum over row l's entries of sum_n |a_{n,k}| |s_c|^n.
   double magnitude(int l) const {
-    const int na = this->na();
-    if (l >= K_ && l + K_ <= L_) {  // columns l - K..l + K in 0..L: the polynomial (mag_poly_)
-      const double x = l;
-      double v = mag_poly_[na];
-      for (int n = na - 1; n >= 0; --n) v = v * x + mag_poly_[n];
-      return v;
-    }
-    const double* absa = absa_.data();
-    double mag = 0;
-    for (int c = std::max(-L_, l - K_); c <= std::min(L_, l + K_); ++c) {
-      const double* c_abs = absa + static_cast<size_t>(K_ + l - c) * (na + 1);
-      const double* tc = t(c);  // |s_c|^n = |w_c^n|
-      double v = 0.0;
-      for (int n = 0; n <= na; ++n) v += c_abs[n] * std::abs(tc[n]);
-      mag += v;
-    }
-    return mag;
+    if (l >= K_ && l + K_ <= L_) return mag_.far(l, na());  // columns l - K..l + K in 0..L
+    return mag_.direct(l, std::max(-L_, l - K_), std::min(L_, l + K_), na(), [this](int c) { return t(c); });
   }
   const double* t(int c) const { return &t_[static_cast<size_t>(c & mask_) * P()]; }
   // Powers of the lines down to c (rows arrive by decreasing line).
@@ -150,10 +119,10 @@ class FoldedRows {
   const Model& m_;
   const HalfInput& U_;
   int R_, L_, K_, Kb_, Km_, na_, nb_, P_, nrhs_, mask_ = 0;
-  Eigen::MatrixXd absa_;
+  CheckMagnitude mag_;
   Eigen::MatrixXcd aj_, bj_;  // the coefficients times j^n (times_j_powers)
   int next_;  // the highest line whose powers are not yet computed
-  std::vector<double> t_, mag_poly_;
+  std::vector<double> t_;
   std::vector<char> nonzero_;
   cd phase_{1.0, 0.0}, step_;
   bool first_ = true;

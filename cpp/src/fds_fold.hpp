@@ -17,6 +17,8 @@
 // Private to the library; fds.cpp decides when to use it and owns the check's decision.
 #pragma once
 #include <Eigen/Dense>
+#include <cmath>
+#include <vector>
 
 #include "lptv/fds.hpp"
 #include "lptv/model.hpp"
@@ -33,6 +35,60 @@ bool can_fold(const Model& m, const Grid& g);
 // Whether the full-grid input is conjugate-symmetric about line 0, exactly (U_0 real), as
 // simulate builds it from one-sided spectra.
 bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full);
+
+// The conditioning check's row magnitude m_l = sum_k sum_n |a_{n,k}| |w0 (l - k)|^n (k = -K..K,
+// the row's columns on lines l - k), shared by the half-grid and the full-grid routes.
+// For |l| >= K every column line lies on l's side of line 0 and m_l is a polynomial in |l|,
+// sum_m p_m |l|^m with p_m = sum_k sum_{n>=m} |a_{n,k}| w0^n C(n,m) (-+k)^(n-m) (the sign of k
+// that of -l): na multiply-adds per row instead of (2K+1)(na+1). It differs from the direct sum
+// by rounding (a few units in its last places): the check only needs its size.
+class CheckMagnitude {
+ public:
+  CheckMagnitude(const Eigen::MatrixXd& absa, double w0)  // absa = |a|: (na+1) x (2K+1)
+      : absa_(absa), K_(static_cast<int>(absa.cols() - 1) / 2), na_(static_cast<int>(absa.rows()) - 1),
+        pos_(na_ + 1, 0.0), neg_(na_ + 1, 0.0) {
+    for (int k = -K_; k <= K_; ++k) {
+      double w0n = 1.0;
+      for (int n = 0; n <= na_; ++n, w0n *= w0) {
+        double binom = 1.0, mk = 1.0;  // C(n, mm) and (-k)^(n-mm), mm from n down
+        for (int mm = n; mm >= 0; --mm) {
+          const double v = absa_(n, K_ + k) * w0n * binom;
+          pos_[mm] += v * mk;                           // l >= K: (w0 (l - k))^n
+          neg_[mm] += ((n - mm) % 2 ? -v : v) * mk;     // l <= -K: (w0 (|l| + k))^n
+          binom = binom * mm / (n - mm + 1);
+          mk *= -k;
+        }
+      }
+    }
+  }
+  // m_l for |l| >= K (na: the model's order, a constant where the caller has one).
+  double far(int l, int na) const {
+    const std::vector<double>& p = l >= 0 ? pos_ : neg_;
+    const double x = std::abs(l);
+    double v = p[na];
+    for (int n = na - 1; n >= 0; --n) v = v * x + p[n];
+    return v;
+  }
+  // The direct sum over the row's columns c = lo..hi (grid indices or lines alike: only the
+  // difference row - c matters), t(c) the real powers of column c's line variable.
+  template <class Powers>
+  double direct(int row, int lo, int hi, int na, const Powers& t) const {
+    double mag = 0;
+    for (int c = lo; c <= hi; ++c) {
+      const double* c_abs = absa_.data() + static_cast<size_t>(K_ + row - c) * (na + 1);
+      const double* tc = t(c);  // |s_c|^n = |w_c^n|
+      double v = 0.0;
+      for (int n = 0; n <= na; ++n) v += c_abs[n] * std::abs(tc[n]);
+      mag += v;
+    }
+    return mag;
+  }
+
+ private:
+  Eigen::MatrixXd absa_;
+  int K_, na_;
+  std::vector<double> pos_, neg_;
+};
 
 // One-sided input: row l is line l (U_0 real), lines beyond the last row are zero.
 using HalfInput = Eigen::Ref<const Eigen::MatrixXcd>;
