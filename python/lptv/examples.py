@@ -247,3 +247,125 @@ def paper_measurements(seed=2024, periods: int = 8) -> dict:
                          **PAPER_NOISE)
     return dict(u=u, y=y, w0=model.w0, u0=ms.signal, y0=y0, U0=ms.spectrum, Y0=Y0, model=model,
                 multisine=ms)
+
+
+# --- two more systems, for statistical claims beyond the paper's example ---------------------
+#
+# Chosen to differ from the paper's example in every respect the statistics could depend on:
+# order, which coefficients vary and by how many harmonics, time domain, excitation spacing,
+# white uncorrelated noise instead of coloured correlated noise, SNR.
+
+THIRD_ORDER_W0 = 0.05
+THIRD_ORDER_N = 1024
+THIRD_ORDER_EXCITED = np.arange(8, 161, 8)
+THIRD_ORDER_ID_LINES = np.arange(1, 171)
+THIRD_ORDER_STRUCTURE = dict(na=3, nb=1, ka=[2, 1, 0, 0], kb=[2, 0])
+
+
+def third_order_model() -> Model:
+    """A third-order continuous-time LPTV system: na = 3, nb = 1, harmonics on a0 (K = 2),
+    a1 (K = 1) and b0 (K = 2); a2, a3 and b1 constant (``THIRD_ORDER_STRUCTURE``).
+
+    Mean system (s + 2) / ((s + 1)(s^2 + s + 1)) = (s + 2) / (s^3 + 2 s^2 + 2 s + 1), w0 = 0.05
+    rad/s (T0 = 126 s), excited every 8th line (0.4 .. 8 rad/s, ``THIRD_ORDER_EXCITED``).
+    Every frozen system is stable and so is the periodic one (a_3 = 1).
+
+    Examples
+    --------
+    >>> import lptv
+    >>> from lptv.examples import third_order_model
+    >>> m = third_order_model()
+    >>> m.na, m.nb, m.ka, m.kb, lptv.floquet(m).is_stable
+    (3, 1, 2, 2, True)
+    """
+    a = np.array([_coefficient_row(1.0, [0.2 + 0.1j, 0.08 - 0.05j]),
+                  _coefficient_row(2.0, [0.15 - 0.1j, 0.0]),
+                  _coefficient_row(2.0, [0.0, 0.0]),
+                  _coefficient_row(1.0, [0.0, 0.0])])
+    b = np.array([_coefficient_row(2.0, [0.3 + 0.2j, -0.1 + 0.1j]),
+                  _coefficient_row(1.0, [0.0, 0.0])])
+    return Model(a, b, w0=THIRD_ORDER_W0)
+
+
+DISCRETE_N = 256
+DISCRETE_EXCITED = np.arange(6, 121, 6)
+DISCRETE_ID_LINES = np.arange(1, 126)
+DISCRETE_STRUCTURE = dict(na=2, nb=1, ka=[2, 1, 0], kb=[2, 0])
+
+
+def discrete_model() -> Model:
+    """A second-order discrete-time LPTV system (forward shift, ts = 1 s, N = 256 samples per
+    period): a2 y[t+2] + a1[t] y[t+1] + a0[t] y[t] = b1 u[t+1] + b0[t] u[t] with harmonics on a0
+    (K = 2), a1 (K = 1) and b0 (K = 2) (``DISCRETE_STRUCTURE``).
+
+    Mean system (0.5 z + 1) / (z^2 - 1.2 z + 0.5) (poles at |z| = 0.71), excited every 6th line
+    (``DISCRETE_EXCITED``). Every frozen system is stable and so is the periodic one.
+
+    Examples
+    --------
+    >>> import lptv
+    >>> from lptv.examples import discrete_model
+    >>> m = discrete_model()
+    >>> m.na, m.nb, m.samples_per_period, lptv.floquet(m).is_stable
+    (2, 1, 256, True)
+    """
+    a = np.array([_coefficient_row(0.5, [0.08 + 0.05j, 0.04j]),
+                  _coefficient_row(-1.2, [0.1 - 0.05j, 0.0]),
+                  _coefficient_row(1.0, [0.0, 0.0])])
+    b = np.array([_coefficient_row(1.0, [0.2, 0.1j]),
+                  _coefficient_row(0.5, [0.0, 0.0])])
+    return Model(a, b, w0=2 * np.pi / DISCRETE_N, ts=1.0)
+
+
+SYSTEMS = ("paper", "third_order", "discrete")
+"""Names of the systems :func:`system_measurements` knows."""
+
+
+def system_measurements(system: str = "paper", seed=0, periods: int = 8) -> dict:
+    """P noisy periods of one of the test systems, with everything a study needs.
+
+    ``system``: 'paper' (:func:`paper_model`, its excitation and coloured correlated noise at
+    50/30 dB), 'third_order' (:func:`third_order_model`, 20 lines, white uncorrelated noise at
+    40/25 dB) or 'discrete' (:func:`discrete_model`, 20 lines, white noise at 45/30 dB with
+    correlation 0.3).
+
+    Returns
+    -------
+    dict
+        As :func:`paper_measurements`, plus ``structure`` (the keyword arguments na, nb, ka, kb
+        of the true structure), ``lines`` (the identification rows), ``ts`` (None or the sample
+        period) and ``noise`` (the keyword arguments of :func:`noisy_periods`).
+
+    Examples
+    --------
+    >>> import lptv
+    >>> from lptv.examples import system_measurements
+    >>> d = system_measurements("discrete", seed=1, periods=4)
+    >>> res = lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], ts=d["ts"],
+    ...                     lines=d["lines"], method="sml")
+    >>> res.n_free_parameters
+    14
+    """
+    if system not in SYSTEMS:
+        raise ValueError(f"system must be one of {SYSTEMS}, got {system!r}")
+    rng = np.random.default_rng(seed)
+    if system == "paper":
+        model, ms = paper_model(), paper_multisine(seed=rng)
+        N, lines, ts = PAPER_N, PAPER_ID_LINES, None
+        structure = dict(na=2, nb=1, ka=3, kb=3)
+        noise = dict(snr_in_db=PAPER_SNR_IN_DB, snr_out_db=PAPER_SNR_OUT_DB, **PAPER_NOISE)
+    elif system == "third_order":
+        model, N, lines, ts = third_order_model(), THIRD_ORDER_N, THIRD_ORDER_ID_LINES, None
+        ms = multisine(THIRD_ORDER_EXCITED, N, amplitudes=np.sqrt(2.0 / THIRD_ORDER_EXCITED.size), seed=rng)
+        structure = dict(THIRD_ORDER_STRUCTURE)
+        noise = dict(snr_in_db=40.0, snr_out_db=25.0)
+    else:
+        model, N, lines, ts = discrete_model(), DISCRETE_N, DISCRETE_ID_LINES, 1.0
+        ms = multisine(DISCRETE_EXCITED, N, amplitudes=np.sqrt(2.0 / DISCRETE_EXCITED.size), seed=rng)
+        structure = dict(DISCRETE_STRUCTURE)
+        noise = dict(snr_in_db=45.0, snr_out_db=30.0, correlation=0.3)
+    Y0 = simulate(model, ms.spectrum)
+    y0 = time_signal(Y0, N)
+    u, y = noisy_periods(ms.signal, y0, periods, seed=rng, **noise)
+    return dict(u=u, y=y, w0=model.w0, ts=ts, u0=ms.signal, y0=y0, U0=ms.spectrum, Y0=Y0,
+                model=model, multisine=ms, structure=structure, lines=lines, noise=noise)
