@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
+from typing import Optional, Tuple
 
 import numpy as np
 
@@ -10,13 +10,19 @@ from . import _core
 from ._validate import as_int, as_positive_float
 from .model import Model
 
-__all__ = ["FloquetResult", "UnstableModelWarning", "floquet", "monodromy"]
+__all__ = ["FloquetResult", "UnstableModelWarning", "floquet", "monodromy", "stability_check",
+           "StabilityUndecidedWarning"]
 
 
 class UnstableModelWarning(UserWarning):
     """The model is unstable (a Floquet multiplier outside the unit circle, an exponent with a
     positive real part): its periodic steady state solves the equation, but a simulation from
     rest does not settle into it (deviations grow like ``spectral_radius ** (t / T0)``)."""
+
+
+class StabilityUndecidedWarning(UserWarning):
+    """The stability check of an identified model could not decide within its cost bound
+    (:func:`stability_check`): typically a_na(t) vanishes or nearly vanishes over the period."""
 
 
 @dataclass(frozen=True)
@@ -164,58 +170,112 @@ def monodromy(model: Model, steps: Optional[int] = 2000) -> np.ndarray:
     return np.asarray(_core.monodromy(model._cpp, steps))
 
 
-def unstable_warning_text(model: Model) -> Optional[str]:
-    """A sentence when ``model`` is unstable beyond its multipliers' error, None otherwise.
+# The stability check of simulate and identify runs on every estimate, including over-fitted,
+# non-converged candidates of lptv.select whose a_na(t) nearly vanishes; its cost is bounded
+# before it starts (METHOD.md section 15): products with at most CHECK_MAX_STEPS steps (about
+# 10 ms), then Hill's method with its matrix at most CHECK_MAX_HILL rows (a few tenths of a
+# second per truncation), and what that does not decide is said, not guessed.
+CHECK_MAX_STEPS = 4096
+CHECK_MAX_HILL = 400
 
-    For :func:`lptv.simulate`: LTI models from the roots of a(s) (a(z)); LPTV models from the
-    monodromy matrix by products (:func:`monodromy` with 32 and 64 steps, under a millisecond
-    where Hill's method takes ~0.1 s on the paper's model), their spectral radii differing by
-    less than a tenth of the distance to 1, and from :func:`floquet` when they do not. The answer is kept on the model (its coefficients cannot change), so
-    repeated simulations of one model pay for it once. A model floquet cannot treat (a_na(t)
-    vanishing, exponents that do not settle) gives None: the simulator has its own checks.
-    Marginal models (a multiplier on the unit circle within its error) give None too: their
-    steady state is reached only in the limit, and the FDS's conditioning check speaks for them
-    when a line sits on the resonance."""
-    cached = model.__dict__.get("_unstable_text")
+
+def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
+    """``(unstable, undecided)``: a sentence when ``model`` is unstable beyond its multipliers'
+    error (else None), and a sentence when the check could not decide within its cost bound
+    (else None); at most one of the two is set.
+
+    LTI models: the roots of a(s) (a(z)). LPTV models: the monodromy matrix by products
+    (:func:`monodromy` with 32, 64, ... up to ``CHECK_MAX_STEPS`` steps, until two successive
+    spectral radii differ by less than a tenth of their distance to 1: under a millisecond on
+    the paper's model), then :func:`floquet` with Hill's matrix at most ``CHECK_MAX_HILL`` rows.
+    A model whose a_na(t) vanishes, whose products overflow or do not settle and whose Hill
+    truncation does not converge within that size is undecided, with the reason. The answer is
+    kept on the model (its coefficients cannot change), so repeated checks of one model pay
+    for it once. Marginal models (a multiplier on the unit circle within its error) are
+    neither: their steady state is reached only in the limit, and the FDS's conditioning check
+    speaks for them when a line sits on the resonance.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.floquet import stability_check
+    >>> from lptv.examples import mathieu_model
+    >>> unstable, undecided = stability_check(mathieu_model(eps=0.1))
+    >>> unstable[:22], undecided
+    ('the model is unstable', None)
+    >>> a = np.array([[0, 1, 0], [0, 1, 0], [1, 0, 1]], dtype=complex)   # a_1(t) = 2 cos(w0 t)
+    >>> stability_check(lptv.Model(a, [[1.0]], w0=1.0))[1][:58]
+    'stability not decided: a: the leading coefficient a_2(t) '
+    """
+    cached = model.__dict__.get("_stability")
     if cached is not None and cached[0] is model._cpp:
         return cached[1]
-    text = None
+    undecided = None
     try:
         if model.is_lti:
-            a = model.a[:, model.ka].real if np.all(model.a.imag == 0) else model.a[:, model.ka]
-            roots = np.roots(a[::-1])
-            if model.discrete:
-                mag = np.abs(roots)
-                # roots of a polynomial with coefficients exact to eps are accurate to about
-                # eps times their condition; 1e-9 is far above that for the orders used here
-                if mag.size and mag.max() > 1.0 + 1e-9:
-                    text = (f"the model is unstable (a root of a(z) at |z| = {mag.max():.6g} > 1)")
-            elif roots.size and roots.real.max() > 1e-9 * max(1.0, np.abs(roots).max()):
-                text = f"the model is unstable (a root of a(s) at s = {roots[np.argmax(roots.real)]:.6g})"
+            text = _lti_unstable_text(model)
         else:
-            text = _lptv_unstable_text(model)
-    except Exception:  # floquet refuses a few models; the simulator reports on those itself
-        text = None
+            text, undecided = _lptv_stability(model)
+    except (ValueError, _core.NumericalError) as err:
+        text, undecided = None, f"stability not decided: {err}"
     if text is not None:
         text += (": the periodic steady state returned solves the equation, but a simulation "
                  "from rest never settles into it")
-    model.__dict__["_unstable_text"] = (model._cpp, text)
-    return text
+    model.__dict__["_stability"] = (model._cpp, (text, undecided))
+    return text, undecided
 
 
-def _lptv_unstable_text(model: Model) -> Optional[str]:
-    rho = []
-    for steps in (32, 64):
-        Phi = monodromy(model, steps)
-        rho.append(float(np.abs(np.linalg.eigvals(Phi)).max()) if np.all(np.isfinite(Phi)) else np.nan)
-    if np.all(np.isfinite(rho)) and abs(rho[1] - rho[0]) < 0.1 * abs(rho[1] - 1.0):
-        if rho[1] > 1.0:
-            return f"the model is unstable (Floquet multiplier of magnitude {rho[1]:.6g} > 1)"
-        return None
-    f = floquet(model)
+def unstable_warning_text(model: Model) -> Optional[str]:
+    """A sentence when ``model`` is unstable beyond its multipliers' error, None otherwise
+    (also None when the check is undecided: see :func:`stability_check`)."""
+    return stability_check(model)[0]
+
+
+def _lti_unstable_text(model: Model) -> Optional[str]:
+    a = model.a[:, model.ka].real if np.all(model.a.imag == 0) else model.a[:, model.ka]
+    roots = np.roots(a[::-1])
+    if model.discrete:
+        mag = np.abs(roots)
+        # roots of a polynomial with coefficients exact to eps are accurate to about
+        # eps times their condition; 1e-9 is far above that for the orders used here
+        if mag.size and mag.max() > 1.0 + 1e-9:
+            return f"the model is unstable (a root of a(z) at |z| = {mag.max():.6g} > 1)"
+    elif roots.size and roots.real.max() > 1e-9 * max(1.0, np.abs(roots).max()):
+        return f"the model is unstable (a root of a(s) at s = {roots[np.argmax(roots.real)]:.6g})"
+    return None
+
+
+def _lptv_stability(model: Model) -> Tuple[Optional[str], Optional[str]]:
+    rho_prev, reason = None, None
+    steps = 32
+    while steps <= CHECK_MAX_STEPS:
+        try:
+            Phi = monodromy(model, steps)
+        except _core.NumericalError as err:   # overflow: too few steps for F(t)'s peaks
+            rho_prev, reason = None, str(err)
+            steps *= 2
+            continue
+        rho = float(np.abs(np.linalg.eigvals(Phi)).max()) if np.all(np.isfinite(Phi)) else np.nan
+        if not np.isfinite(rho):
+            rho_prev = None
+        elif rho_prev is not None and abs(rho - rho_prev) < 0.1 * abs(rho - 1.0):
+            if rho > 1.0:
+                return f"the model is unstable (Floquet multiplier of magnitude {rho:.6g} > 1)", None
+            return None, None
+        else:
+            rho_prev = rho
+        steps *= 2
+    hill_max = max(1, (CHECK_MAX_HILL // max(model.na, 1) - 1) // 2)
+    try:
+        f = floquet(model, max_truncation=hill_max)
+    except _core.NumericalError as err:
+        why = f"; the products: {reason}" if reason else ""
+        return None, (f"stability not decided within the check's cost bound: the products of up to "
+                      f"{CHECK_MAX_STEPS} steps did not settle and Hill's method did not converge "
+                      f"({err}){why}; lptv.floquet(model, max_truncation=...) can try harder")
     k = int(np.argmax(np.abs(f.multipliers)))
     mu, err = abs(f.multipliers[k]), f.error_estimate[k]
     if mu > 1.0 and (mu - 1.0) > err * max(mu, 1.0):
         return (f"the model is unstable (Floquet multiplier of magnitude {mu:.6g} > 1, "
-                f"Floquet exponent with real part {f.exponents[k].real:.6g} 1/s)")
-    return None
+                f"Floquet exponent with real part {f.exponents[k].real:.6g} 1/s)"), None
+    return None, None

@@ -11,7 +11,7 @@ import numpy as np
 
 from . import _core
 from .data import FrequencyData, experiments_of, frequency_data_of
-from .floquet import UnstableModelWarning, unstable_warning_text
+from .floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
 from .model import Model
 from ._validate import as_counts, as_float, as_int, as_lines, as_positive_float
 
@@ -81,10 +81,17 @@ class IdentificationResult:
     circle; also warned as :class:`lptv.UnstableModelWarning`), None otherwise. Steady-state data
     of a stabilised experiment identify an unstable system correctly; the sentence says what its
     predicted output means."""
+    stability_undecided: Optional[str] = None
+    """A sentence when the stability check could not decide within its cost bound (a_na(t)
+    vanishing or nearly so: an over-fitted or unconverged estimate), None otherwise; also
+    warned as :class:`lptv.StabilityUndecidedWarning`. ``lptv.floquet(res.model,
+    max_truncation=...)`` can try harder."""
     experiment: Optional[np.ndarray] = field(default=None, repr=False)
     """Per row of ``lines``: the index of the experiment it belongs to (all 0 for one data set)."""
     experiments: Tuple[FrequencyData, ...] = field(default_factory=tuple, repr=False)
     """Several experiments fitted together: their data in the order given (``data`` is then None)."""
+    structure: Optional[object] = field(default=None, repr=False, compare=False)
+    """The core's Structure of the fit (orders, harmonic counts, known coefficients)."""
 
     @property
     def n_experiments(self) -> int:
@@ -222,8 +229,13 @@ class IdentificationResult:
     @cached_property
     def prediction_error_db(self) -> Optional[float]:
         """Mean power of Y - Y_model (the model's output from the measured mean input) over the
-        variance of the mean output, on :attr:`verdict_lines`, in dB (about 0 dB for a model the
-        noise explains). None without data or where it cannot be computed."""
+        variance that the noise gives it, on :attr:`verdict_lines`, in dB (about 0 dB for a model
+        the noise explains). That variance is the output's plus the input noise carried through
+        the model, sum_i |G_{l,i}|^2 var U_i (G the model's HTF): where the gain is high the
+        input noise dominates it; and, for WGTLS and SML, the estimate's own uncertainty carried
+        to the predicted output, g_l^T Cov(eta) g_l (g_l = dY_model,l / d eta): where the output is
+        sensitive to the parameters it can exceed the noise of a line many times over. None
+        without data or where it cannot be computed."""
         datas = self.experiments or ((self.data,) if self.data is not None else ())
         if not datas:
             return None
@@ -243,8 +255,16 @@ class IdentificationResult:
                 return None
             if Yp.shape != d.Y.shape:
                 return None
+            from .verdict import prediction_variance, propagated_input_noise
+
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    spread = propagated_input_noise(self.model, d, rows) + prediction_variance(self, d, rows, Yp)
+            except (ValueError, _core.NumericalError):   # the model's HTF cannot be had
+                return None
             err.append(np.abs(d.Y[rows] - Yp[rows]) ** 2)
-            noise.append(d.varY[rows])
+            noise.append(d.varY[rows] + spread)
         if not err:
             return None
         err, noise = float(np.mean(np.concatenate(err))), float(np.mean(np.concatenate(noise)))
@@ -252,20 +272,46 @@ class IdentificationResult:
             return None
         return float(10 * np.log10(err / noise))
 
+    @cached_property
+    def residue_tests(self):
+        """The verdict's residue tests (:class:`lptv.verdict.ResidueTests`, METHOD.md section 7):
+        every row that reads a line with signal is judged, per group of rows at the same distance
+        from the excited lines and over all of them, each row's normalised residue corrected for
+        the fit's shrinkage and put on a standard normal scale, the tests combined by Holm's
+        method at an overall size of 1 %. None when the data carry no noise or were not kept."""
+        from .verdict import residue_tests
+
+        try:
+            return residue_tests(self, self.structure)
+        except (ValueError, np.linalg.LinAlgError, _core.NumericalError):
+            return None
+
+    @property
+    def judged_lines(self) -> np.ndarray:
+        """The rows the residue tests judge: those that read an output or input line standing
+        above its noise (within +-K of the row)."""
+        t = self.residue_tests
+        return self.verdict_lines if t is None else self.lines[t.judged]
+
     PREDICTION_LIMIT_DB = 10.0
     """A prediction error this far above the output noise (dB) rejects the model."""
 
     @property
     def model_errors(self) -> Tuple[str, ...]:
-        """The signs of a model error, each as a sentence (empty when none): residues outside the
-        predicted band on the excited lines, a cost far above 1, a prediction error far above the
-        noise. Any one rejects the model, whatever the fraction on all rows says."""
+        """The signs of a model error, each as a sentence (empty when none): a residue test of
+        :attr:`residue_tests` that rejects (or, without them, residues outside the predicted band
+        on the excited lines), a cost far above 1, a prediction error far above the noise. Any
+        one rejects the model, whatever the fraction on all rows says."""
         out = []
-        lo, hi = self.verdict_band
-        if not lo <= self.verdict_fraction <= hi:
-            out.append(f"{100 * self.verdict_fraction:.1f} % of the normalised residues on the "
-                       f"{self.verdict_lines.size} excited lines are above 0 dB, outside the predicted "
-                       f"{100 * lo:.1f}-{100 * hi:.1f} %")
+        tests = self.residue_tests
+        if tests is not None:
+            out.extend(tests.sentences())
+        else:
+            lo, hi = self.verdict_band
+            if not lo <= self.verdict_fraction <= hi:
+                out.append(f"{100 * self.verdict_fraction:.1f} % of the normalised residues on the "
+                           f"{self.verdict_lines.size} excited lines are above 0 dB, outside the predicted "
+                           f"{100 * lo:.1f}-{100 * hi:.1f} %")
         lim = self.cost_limit
         if lim is not None and self.cost > lim:
             out.append(f"the cost {self.cost:.3g} is far above its noise level (limit {lim:.3g})")
@@ -303,8 +349,10 @@ class IdentificationResult:
         """One sentence: is the model consistent with the noise, and if not, why. A fit the data
         do not determine (:attr:`undetermined`) is never called consistent."""
         if self.model_ok and self.undetermined is None:
+            where = (f"{self.judged_lines.size} rows with signal" if self.residue_tests is not None
+                     else f"{self.verdict_lines.size} excited lines")
             return ("the model is consistent with the noise: the fit shows no sign of modelling errors "
-                    f"(on the {self.verdict_lines.size} excited lines)")
+                    f"(on the {where})")
         if self.model_ok:
             return "NOT DETERMINED: no sign of modelling errors, but " + self.undetermined
         out = "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors)
@@ -340,6 +388,8 @@ class IdentificationResult:
         lines += [f"warning: {w}" for w in self.warnings]
         if self.unstable:
             lines.append(f"warning: {self.unstable}")
+        if self.stability_undecided:
+            lines.append(f"warning: {self.stability_undecided}")
         return "\n".join(lines)
 
 
@@ -534,7 +584,10 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
     cov = r.covariance
     model = Model._from_core(r.model)
-    unstable = unstable_warning_text(model)
+    unstable, undecided = stability_check(model)
+    if undecided is not None:
+        undecided = "the identified model's " + undecided
+        warnings.warn(undecided, StabilityUndecidedWarning, stacklevel=2)
     if unstable is not None:
         # said once here; the verdict's own simulation of the estimate stays silent
         unstable = ("the identified " + unstable[len("the "):].split(": the periodic")[0]
@@ -553,7 +606,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         warnings=tuple(r.warnings), data=None if several else data, eta_names=tuple(r.eta_names),
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
-        unstable=unstable)
+        unstable=unstable, stability_undecided=undecided, structure=structure)
 
 
 def _experiment_rows(datas, lines, K):

@@ -1,0 +1,284 @@
+"""The residue tests behind the verdict of :func:`lptv.identify` (METHOD.md section 7).
+
+A model error shows where the data carry signal, and for a time-varying model often away from
+the excited lines: a harmonic the fit leaves out moves power to the lines k away from each
+excited line, where the rows of a fitted model with fewer harmonics see it. So the verdict
+judges every row that reads a line with signal, and combines tests that noise-only rows
+cannot dilute:
+
+- per *offset group*: the rows at the same distance |d| from their nearest excited line,
+  pooled over the excited lines (a missing harmonic or order acts alike at every excited
+  line);
+- over all judged rows, two-sided (residues too large: a model error; too small: residues
+  that the fit has absorbed, an over-fitted structure or a wrong noise level).
+
+Each row's normalised residue is put on the null distribution it has after the fit: divided
+by its expected shrinkage 1 - h_l (the estimating equation's leverage, from the residue
+covariance after the fit), then mapped through the F(2, 2(P-1)) distribution function (Exp(1)
+for known variances) to a standard normal score. A group's statistic is the sum of its scores
+over the standard deviation of that sum, the scores' correlation taken from the residues'
+(rows that share noisy lines). The p-values are combined by Holm's method at an overall size
+``ALPHA``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import _core
+
+ALPHA = 0.01
+"""Overall size of the residue tests (Holm's combination)."""
+SIGNAL_FALSE_RATE = 1e-3
+"""A line counts as carrying signal when its power over its noise variance exceeds the
+quantile of the noise-only distribution that noise alone exceeds with this probability."""
+
+
+@dataclass(frozen=True)
+class ResidueTest:
+    """One test of the verdict's family."""
+
+    name: str
+    """'all judged rows' or 'rows |d| = k from the excited lines'."""
+    rows: np.ndarray
+    """The lines of the rows it sums over."""
+    statistic: float
+    """Sum of the rows' normal scores over its standard deviation (standard normal without a
+    model error)."""
+    p_value: float
+    """One-sided (upper) for an offset group, two-sided for all judged rows."""
+    p_holm: float
+    """Holm-adjusted p-value (reject when below ``ALPHA``)."""
+
+    @property
+    def rejects(self) -> bool:
+        return self.p_holm <= ALPHA
+
+
+@dataclass(frozen=True)
+class ResidueTests:
+    """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`)."""
+
+    tests: Tuple[ResidueTest, ...]
+    judged: np.ndarray
+    """Per row of the fit: judged (the row reads a line with signal)."""
+    score: np.ndarray
+    """Per row of the fit: the normal score of its normalised residue after the fit's shrinkage
+    (NaN for rows not judged)."""
+    leverage: np.ndarray
+    """Per row of the fit: 1 - E|e_l|^2 / var e_l after the fit (its share of the parameters)."""
+    alpha: float = ALPHA
+
+    @property
+    def rejected(self) -> Tuple[ResidueTest, ...]:
+        return tuple(t for t in self.tests if t.rejects)
+
+    def sentences(self) -> Tuple[str, ...]:
+        out = []
+        for t in self.rejected:
+            side = "too large" if t.statistic > 0 else "too small"
+            out.append(f"the normalised residues on the {t.rows.size} {t.name} are {side} "
+                       f"(z = {t.statistic:.2f}, p = {t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} "
+                       f"< {self.alpha:g})")
+        return tuple(out)
+
+
+def _signal_lines(d, P: int) -> np.ndarray:
+    """Lines 0..max_line where the output or the input stands above its noise."""
+    from scipy import stats
+
+    if P >= 2:
+        nu = 2 * (P - 1)
+        q = stats.f.isf(SIGNAL_FALSE_RATE, 2, nu)
+    else:
+        q = -np.log(SIGNAL_FALSE_RATE)
+    out = np.zeros(d.max_line + 1, bool)
+    for X, v in ((np.asarray(d.Y), np.asarray(d.varY)), (np.asarray(d.U), np.asarray(d.varU))):
+        p = np.abs(X) ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out |= np.where(v > 0, p > q * v, p > 1e-20 * max(p.max(), 1e-300))
+    return out
+
+
+def _real_jacobian(J: np.ndarray, T: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """Rows interleaved (Re e_l, Im e_l), free real parameters as columns."""
+    JT = (J @ T)[:, free]
+    out = np.empty((2 * J.shape[0], JT.shape[1]))
+    out[0::2], out[1::2] = JT.real, JT.imag
+    return out
+
+
+def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None) -> Optional[ResidueTests]:
+    """The verdict's tests of an identification result, or None when they cannot be formed
+    (no data kept, no noise, no rows). ``structure`` is the core's Structure of the fit;
+    ``excited`` the excited lines of each experiment (default: ``lptv.excited_lines``)."""
+    from scipy import stats
+
+    datas = list(res.experiments) if res.experiments else ([res.data] if res.data is not None else [])
+    if not datas or res.noise_free or structure is None:
+        return None
+    par = _core.Parametrisation(structure)
+    K = max(structure.kmax, 0)
+    T = np.asarray(par.T)
+    free = np.ones(T.shape[1], bool)
+    if par.norm_index >= 0:
+        free[par.norm_index] = False
+    lines = np.asarray(res.lines)
+    experiment = res.experiment if res.experiment is not None else np.zeros(lines.size, int)
+    theta = np.asarray(res.theta)
+    # Per experiment: its rows in sorted order, S (interleaved), the real Jacobian.
+    order, S_blocks, J_blocks, nus, signal_rows, offsets = [], [], [], [], [], []
+    for e, d in enumerate(datas):
+        idx = np.flatnonzero(experiment == e)
+        if idx.size == 0:
+            continue
+        like = _core.ExactLikelihood(d._cpp, par, [int(x) for x in lines[idx]])
+        srt = np.asarray(like.sorted_rows)
+        pos = {int(l): int(i) for l, i in zip(lines[idx], idx)}
+        order.append(np.array([pos[int(l)] for l in srt]))
+        S_blocks.append(np.asarray(like.residue_covariance(theta)))
+        J_blocks.append(_real_jacobian(np.asarray(_core.jacobian(d._cpp, par, [int(l) for l in srt])), T, free))
+        P = int(d.periods)
+        nus.append(np.full(srt.size, 2.0 * (P - 1) if P >= 2 else np.inf))
+        sig = _signal_lines(d, P)
+        near = np.zeros(srt.size, bool)
+        for k in range(-K, K + 1):
+            i = np.clip(srt + k, 0, d.max_line)
+            near |= sig[i]
+        signal_rows.append(near)
+        ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
+        offsets.append(_offset_groups(srt, ex))
+    if not order:
+        return None
+    order = np.concatenate(order)
+    n2 = 2 * order.size
+    S = np.zeros((n2, n2))
+    o = 0
+    for B in S_blocks:
+        S[o:o + B.shape[0], o:o + B.shape[0]] = B
+        o += B.shape[0]
+    Jc = np.vstack(J_blocks)
+    sd = np.diag(S).copy()
+    if not np.all(sd > 0):
+        return None
+    # Leverage of the estimating equation J^T W r = 0, W = diag(1 / S_ii); the residue after
+    # the fit is (I - Pi) r0 to first order, with covariance S_r = (I - Pi) S (I - Pi)^T.
+    w = 1.0 / sd
+    Q, Rf = np.linalg.qr(Jc * np.sqrt(w)[:, None])
+    X = Jc @ np.linalg.pinv(Rf.T @ Rf)                    # Jc (Jc^T W Jc)^-1
+    PiS = X @ ((Jc * w[:, None]).T @ S)                    # Pi S
+    G = (Jc * w[:, None]).T @ S @ (Jc * w[:, None])
+    Sr = S - PiS - PiS.T + X @ G @ X.T
+    m = order.size
+    blocks = Sr.reshape(m, 2, m, 2)
+    sig2 = blocks[np.arange(m), 0, np.arange(m), 0] + blocks[np.arange(m), 1, np.arange(m), 1]
+    v = sd[0::2] + sd[1::2]
+    shrink = np.clip(sig2 / v, 0.05, None)
+    z = np.asarray(res.normalized_residue)[order] ** 2 / shrink
+    nu = np.concatenate(nus)
+    u = np.where(np.isfinite(nu), stats.f.cdf(z, 2, np.where(np.isfinite(nu), nu, 1.0)), -np.expm1(-z))
+    score = stats.norm.ppf(np.clip(u, 1e-300, 1 - 1e-16))
+    # Correlation of the rows' |e|^2 (Gaussian): ||C_ll'||_F^2 / (||C_ll||_F ||C_l'l'||_F).
+    F2 = np.einsum("iajb,iajb->ij", blocks, blocks)
+    dF = np.sqrt(np.diag(F2))
+    corr = F2 / np.outer(dF, dF)
+    judged = np.concatenate(signal_rows)
+    groups = np.concatenate(offsets)
+    if not judged.any():
+        judged = np.ones(m, bool)
+    tests = []
+
+    def stat(mask):
+        s = score[mask].sum()
+        return float(s / np.sqrt(corr[np.ix_(mask, mask)].sum()))
+
+    t_all = stat(judged)
+    tests.append(("all judged rows", judged, t_all, float(2 * stats.norm.sf(abs(t_all)))))
+    for g in np.unique(groups[groups >= 0]):
+        mask = judged & (groups == g)
+        if mask.any() and not np.array_equal(mask, judged):
+            t = stat(mask)
+            tests.append((f"rows |d| = {g} from the excited lines", mask, t, float(stats.norm.sf(t))))
+    # Holm's step-down adjustment.
+    p = np.array([t[3] for t in tests])
+    k = p.size
+    srt = np.argsort(p)
+    adj = np.empty(k)
+    run = 0.0
+    for rank, i in enumerate(srt):
+        run = max(run, min(1.0, (k - rank) * p[i]))
+        adj[i] = run
+    inv = np.empty(m, int)
+    inv[order] = np.arange(m)
+    out_tests = tuple(ResidueTest(name=t[0], rows=np.sort(lines[order[t[1]]]), statistic=t[2], p_value=t[3],
+                                  p_holm=float(adj[i])) for i, t in enumerate(tests))
+    score_rows = np.where(judged, score, np.nan)[inv]
+    return ResidueTests(tests=out_tests, judged=judged[inv], score=score_rows, leverage=(1.0 - shrink)[inv])
+
+
+def _offset_groups(rows: np.ndarray, excited: np.ndarray) -> np.ndarray:
+    """|distance| of each row to its nearest excited line, capped at half the spacing; -1 for
+    every row when the excited lines are neighbours (no gaps) or fewer than two."""
+    excited = np.unique(excited)
+    if excited.size < 2:
+        return np.full(rows.size, -1)
+    spacing = int(np.median(np.diff(excited)))
+    if spacing <= 1:
+        return np.full(rows.size, -1)
+    pos = np.searchsorted(excited, rows)
+    lo = excited[np.clip(pos - 1, 0, excited.size - 1)]
+    hi = excited[np.clip(pos, 0, excited.size - 1)]
+    d = np.minimum(np.abs(rows - lo), np.abs(rows - hi))
+    return np.minimum(d, spacing // 2)
+
+
+def propagated_input_noise(model, d, rows: np.ndarray) -> np.ndarray:
+    """sum_i |G_{l,i}|^2 var U_i on the output lines ``rows``: the variance the input noise
+    gives the model's output Y_model = G U (G = A^-1 B, the model's HTF), lines taken as
+    independent. Continuous time: the input lines from -W to max(rows) + W with W = 2K + 16
+    (the HTF decays away from its diagonal), on a grid with 64 guard lines beyond them."""
+    from .fds import htf
+
+    varU = np.asarray(d.varU)
+    rows = np.asarray(rows, int)
+    if model.discrete:
+        N = model.samples_per_period
+        G = htf(model, 0)                                   # (N, N): output line i, input j
+        j = np.arange(N)
+        vj = varU[np.minimum(j, N - j)] if varU.size > N // 2 else np.zeros(N)
+        return (np.abs(G[rows % N]) ** 2) @ vj
+    K = max(model.ka, model.kb)
+    W = 2 * K + 16
+    cols = np.arange(-W, int(rows.max()) + W + 1)
+    L = int(cols.max()) + 64
+    G = htf(model, L, cols)                                 # (2L+1, cols)
+    vU = np.zeros(cols.size)
+    ok = np.abs(cols) <= d.max_line
+    vU[ok] = varU[np.abs(cols[ok])]
+    return (np.abs(G[rows + L]) ** 2) @ vU
+
+
+def prediction_variance(res, d, rows: np.ndarray, Yp: np.ndarray) -> np.ndarray:
+    """g_l^H Cov(eta) g_l on ``rows``, g_l = dY_model,l / d eta by forward differences of the
+    simulated output (the model is linear in its coefficients; a relative step of 1e-7 leaves
+    an error of that order in g); zero without a covariance."""
+    from .fds import simulate
+    from .model import Model
+
+    cov = res.covariance
+    if cov is None or res.structure is None:
+        return np.zeros(np.asarray(rows).size)
+    par = _core.Parametrisation(res.structure)
+    T = np.asarray(par.T)
+    theta = np.asarray(res.theta)
+    idx = np.flatnonzero(np.diag(cov) > 0)
+    g = np.empty((np.asarray(rows).size, idx.size), complex)
+    scale = max(float(np.abs(theta).max()), 1e-300)
+    for c, j in enumerate(idx):
+        h = 1e-7 * scale / max(float(np.abs(T[:, j]).max()), 1e-300)
+        m = Model._from_core(par.to_model(theta + h * T[:, j]))
+        g[:, c] = (np.asarray(simulate(m, d.U, warn_unstable=False))[rows] - Yp[rows]) / h
+    C = cov[np.ix_(idx, idx)]
+    return np.real(np.einsum("li,ij,lj->l", g.conj(), C, g))
