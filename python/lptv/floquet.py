@@ -201,10 +201,10 @@ def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
     >>> from lptv.floquet import stability_check
     >>> from lptv.examples import mathieu_model
     >>> unstable, undecided = stability_check(mathieu_model(eps=0.1))
-    >>> unstable[:22], undecided
+    >>> unstable[:21], undecided
     ('the model is unstable', None)
     >>> a = np.array([[0, 1, 0], [0, 1, 0], [1, 0, 1]], dtype=complex)   # a_1(t) = 2 cos(w0 t)
-    >>> stability_check(lptv.Model(a, [[1.0]], w0=1.0))[1][:58]
+    >>> stability_check(lptv.Model(a, [[1.0]], w0=1.0))[1][:57]
     'stability not decided: a: the leading coefficient a_2(t) '
     """
     cached = model.__dict__.get("_stability")

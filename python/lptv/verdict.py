@@ -41,7 +41,8 @@ class ResidueTest:
     """One test of the verdict's family."""
 
     name: str
-    """'all judged rows' or 'rows |d| = k from the excited lines'."""
+    """'rows with signal' (all judged rows) or 'rows d lines from the nearest excited line'
+    (an offset group)."""
     rows: np.ndarray
     """The lines of the rows it sums over."""
     statistic: float
@@ -123,7 +124,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     K = max(structure.kmax, 0)
     T = np.asarray(par.T)
     free = np.ones(T.shape[1], bool)
-    if par.norm_index >= 0:
+    if 0 <= par.norm_index < free.size:   # with known coefficients no parameter is normalised
         free[par.norm_index] = False
     lines = np.asarray(res.lines)
     experiment = res.experiment if res.experiment is not None else np.zeros(lines.size, int)
@@ -195,12 +196,12 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         return float(s / np.sqrt(corr[np.ix_(mask, mask)].sum()))
 
     t_all = stat(judged)
-    tests.append(("all judged rows", judged, t_all, float(2 * stats.norm.sf(abs(t_all)))))
+    tests.append(("rows with signal", judged, t_all, float(2 * stats.norm.sf(abs(t_all)))))
     for g in np.unique(groups[groups >= 0]):
         mask = judged & (groups == g)
         if mask.any() and not np.array_equal(mask, judged):
             t = stat(mask)
-            tests.append((f"rows |d| = {g} from the excited lines", mask, t, float(stats.norm.sf(t))))
+            tests.append((f"rows {g} lines from the nearest excited line", mask, t, float(stats.norm.sf(t))))
     # Holm's step-down adjustment.
     p = np.array([t[3] for t in tests])
     k = p.size
