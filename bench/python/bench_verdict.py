@@ -28,7 +28,7 @@ import numpy as np
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import lptv  # noqa: E402
-from lptv.examples import noisy_periods, system_measurements  # noqa: E402
+from lptv.examples import SYSTEMS, noisy_periods, system_measurements  # noqa: E402
 
 CASES = ("true", "extra_harmonic", "a0_fewer", "missing_order")
 
@@ -61,7 +61,7 @@ def _structure(case, st):
 
 def one(args):
     system, P, seed = args
-    rng = np.random.default_rng([seed, P, hash(system) % 2**31])
+    rng = np.random.default_rng([seed, P, SYSTEMS.index(system)])
     out = []
     base = system_measurements(system, seed=rng, periods=P)
     for case in CASES:

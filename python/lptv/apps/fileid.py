@@ -172,7 +172,7 @@ def add_parser(sub):
                    help="drop the first K periods (a start-up transient)")
     p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150, or 'excited' (the lines "
                    "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
-                   "judges the excited lines")
+                   "judges every row that reads a line with signal")
     p.add_argument("--method", default="wgtls", choices=METHODS, help="estimator (default wgtls)")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
@@ -300,6 +300,7 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "undetermined": res.undetermined,
         "n_verdict_lines": int(res.verdict_lines.size), "verdict_fraction_above_0db": res.verdict_fraction,
         "verdict_band": list(res.verdict_band),
+        "residue_tests": _json_residue_tests(res),
         "parameters": parameter_table(res),
         "lti": _json_lti(res),
         "warnings": list(res.warnings) + extra,
@@ -361,13 +362,19 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
                  fontsize="medium")
     rep.figure(ax.figure, "normalized_residue.png",
                f"Normalised residue |e_l| / sqrt(var e_l) against frequency with the 0 dB line. On the "
-               f"{res.verdict_lines.size} excited lines, which the verdict judges, "
+               f"{res.verdict_lines.size} excited lines (marked) "
                f"{100 * res.verdict_fraction:.1f} % lie above 0 dB, where noise alone gives "
                f"{100 * vlo:.1f}-{100 * vhi:.1f} %; on all {rows.size} lines of the fit "
                f"{100 * res.fraction_above_0db:.1f} % (expected {100 * res.fraction_expected:.1f} %, band "
-               f"{100 * lo:.1f}-{100 * hi:.1f} %). "
+               f"{100 * lo:.1f}-{100 * hi:.1f} %). The verdict judges the {res.judged_lines.size} rows "
+               "that read a line with signal, by the tests in the table below. "
                + ("The fit shows no sign of modelling errors." if res.model_ok else
                   "The model is rejected: " + "; ".join(res.model_errors) + "."))
+    tests = _json_residue_tests(res)
+    if tests:
+        rep.table(["residue test (rows)", "rows", "z", "p", "Holm-adjusted p", "rejects at 1 %"],
+                  [[t["name"], t["n_rows"], t["statistic"], t["p_value"], t["p_holm"], t["rejects"]]
+                   for t in tests])
 
     t = np.linspace(0.0, model.period, 400)
     ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
@@ -412,3 +419,13 @@ def read_record(src, args):
             period = 2 * np.pi / args.w0
     return read_measurements(src, args.periods, fs=args.fs, dt=args.dt, period=period,
                              trim=args.trim, skip_periods=args.skip_periods)
+
+
+def _json_residue_tests(res):
+    """The verdict's residue tests as plain values (an empty list without them)."""
+    tests = res.residue_tests
+    if tests is None:
+        return []
+    return [{"name": t.name, "n_rows": int(t.rows.size), "statistic": float(t.statistic),
+             "p_value": float(t.p_value), "p_holm": float(t.p_holm), "rejects": bool(t.rejects)}
+            for t in tests.tests]

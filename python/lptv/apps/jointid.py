@@ -156,7 +156,8 @@ def _report(records, res, summary) -> Report:
         ax.set_title(f"record #{e}: {Path(src).name}", fontsize="medium")
         rep.figure(ax.figure, f"normalized_residue_{e}.png",
                    f"Normalised residue |e_l| / sqrt(var e_l) of record #{e} ({src}) against frequency, with "
-                   "the 0 dB line; the excited lines, which the verdict judges, marked.")
+                   "the 0 dB line; the excited lines marked (the verdict judges every row that reads a line "
+                   "with signal).")
     t = np.linspace(0.0, model.period, 400)
     ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
                                   discrete=model.discrete)
