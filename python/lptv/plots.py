@@ -192,7 +192,7 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
         on = np.isin(np.asarray(lines), np.asarray(excited))
         ax.plot(x[~on], _db(np.asarray(r)[~on]), ".", ms=3, color="0.6", label="other lines of the fit")
         ax.plot(x[on], _db(np.asarray(r)[on]), "o", ms=4, color="C0", zorder=3,
-                label="excited lines (judged by the verdict)")
+                label="excited lines")
         ax.legend(fontsize="small")
     ax.axhline(0.0, color="k", lw=1)
     title = []
@@ -205,6 +205,44 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
     ax.set_xlabel(xlabel)
     ax.set_ylabel("normalised residue (dB)")
     ax.grid(True, alpha=0.3)
+    return ax
+
+
+def residue_tests(res, *, ax=None):
+    """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`) as bars: each
+    test's statistic z (standard normal without a model error) with the level at which the
+    smallest p-value rejects under Holm's method (overall size 1 %); rejecting tests in red.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import system_measurements
+    >>> d = system_measurements("third_order", seed=1, periods=8)
+    >>> res = lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], lines=d["lines"])
+    >>> ax = lptv.plots.residue_tests(res)
+    >>> [t.get_text().split()[0] for t in ax.get_xticklabels()][:2]
+    ['all', '|d|']
+    """
+    from scipy import stats
+
+    tests = getattr(res, "residue_tests", None)
+    if tests is None:
+        raise ValueError("res: the fit has no residue tests (no noise in the data, or no data kept)")
+    ax = _axes(ax)
+    names = [("all rows" if t.name == "rows with signal" else "|d| = " + t.name.split()[1]) + f"\n({t.rows.size})"
+             for t in tests.tests]
+    z = np.array([t.statistic for t in tests.tests])
+    colors = ["C3" if t.rejects else "C0" for t in tests.tests]
+    ax.bar(np.arange(z.size), z, color=colors)
+    k = z.size
+    ax.axhline(stats.norm.isf(tests.alpha / k), color="k", ls="--", lw=1,
+               label=f"Holm's first level ({100 * tests.alpha:g} % / {k}, one-sided)")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xticks(np.arange(z.size), names, fontsize="small")
+    ax.set_ylabel("z (N(0, 1) without a model error)")
+    ax.set_xlabel("rows (count): all rows with signal; rows d lines from the nearest excited line")
+    ax.legend(fontsize="small")
+    ax.grid(True, axis="y", alpha=0.3)
     return ax
 
 

@@ -375,6 +375,12 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
         rep.table(["residue test (rows)", "rows", "z", "p", "Holm-adjusted p", "rejects at 1 %"],
                   [[t["name"], t["n_rows"], t["statistic"], t["p_value"], t["p_holm"], t["rejects"]]
                    for t in tests])
+        ax = plots.residue_tests(res)
+        rep.figure(ax.figure, "residue_tests.png",
+                   "The verdict's residue tests: per group of rows at the same distance d from the "
+                   "nearest excited line, and over all rows with signal, the sum of the rows' normal "
+                   "scores over its standard deviation (standard normal without a model error); a bar "
+                   "above the dashed line rejects (Holm's method, overall size 1 %, METHOD.md section 7).")
 
     t = np.linspace(0.0, model.period, 400)
     ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
