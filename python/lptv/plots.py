@@ -208,6 +208,53 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
     return ax
 
 
+def distortion(d, *, hz: bool = False, ax=None):
+    """Signal, noise and nonlinear distortion levels per output line in dB (FDIDENT's picture of
+    a nonlinear measurement): the output power on the excited lines and their sidebands, the
+    noise of a period mean, and the stochastic nonlinear distortion (a
+    :class:`lptv.DistortionResult`).
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import noisy_periods, paper_model
+    >>> m = paper_model()
+    >>> u, y = [], []
+    >>> for r in range(6):
+    ...     ms = lptv.multisine(range(10, 241, 10), 2048, seed=r)
+    ...     y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 2048)
+    ...     a, b = noisy_periods(ms.signal, y0 + 0.05 * y0 ** 3, 4, 50, 30, seed=100 + r)
+    ...     u.append(a); y.append(b)
+    >>> ax = lptv.plots.distortion(lptv.distortion(np.array(u), np.array(y), w0=m.w0))
+    >>> ax.get_ylabel()
+    'power (dB)'
+    """
+    from .distortion import DistortionResult
+    from ._validate import as_bool
+
+    if not isinstance(d, DistortionResult):
+        raise ValueError(f"d must be an lptv.DistortionResult, got {type(d).__name__}")
+    hz = as_bool(hz, "hz")
+    ax = _axes(ax)
+    x = d.w / (2 * np.pi) if hz else d.w
+    ok = np.isfinite(d.p_value)
+    for kind, style, label in (("excited", dict(marker="o", ms=4, color="C0"), "output, excited lines"),
+                               ("sideband", dict(marker=".", ms=3, color="C2"),
+                                f"output, sidebands (+-{d.branches})")):
+        sel = d.kind == kind
+        ax.plot(x[sel], _db(np.sqrt(d.signal[sel])), ls="none", label=label, **style)
+    ax.plot(x[ok], _db(np.sqrt(d.noise[ok])), color="0.5", lw=1, label="noise (from the periods)")
+    nl = np.where(ok & (d.nonlinear > 0), d.nonlinear, np.nan)
+    ax.plot(x, _db(np.sqrt(nl)), "x", ms=3, color="C3", label="nonlinear distortion (from the realisations)")
+    ax.set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
+    ax.set_ylabel("power (dB)")
+    ax.set_title(f"{d.realisations} realisations x {d.periods} periods: nonlinear distortion "
+                 f"{'detected' if d.detected else 'not detected'} (p = {d.p_overall:.2g})", fontsize="medium")
+    ax.legend(fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
 def residue_tests(res, *, ax=None):
     """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`) as bars: each
     test's statistic z (standard normal without a model error) with the level at which the

@@ -1,0 +1,264 @@
+"""Nonlinear distortion and the best linear (time-periodic) approximation from M random-phase
+realisations of P periods (METHOD.md section 16).
+
+An LPTV system and a nonlinear one both put output power on lines the input does not excite.
+What tells them apart is how that power depends on the input's phases: an LPTV system's
+output line j is a fixed linear combination of the excited lines within its HTF's reach,
+Y_j = sum_c G_{j-c}(w_c) U_c, the same coefficients for every realisation; a nonlinear
+system's stochastic distortion Y_S,j varies from realisation to realisation like a noise
+that does not average out over the periods. So, per output line j, the M realisations' period
+means are regressed on the excited lines within +-Kh of j (their conjugates near DC):
+
+    Y_j^[m] = sum_c G_{j-c}(w_c) U_c^[m] + E_j^[m],   m = 1..M,   q_j regressors
+
+by least squares. The residual power over its 2 (M - q_j) real degrees of freedom estimates
+the variance of E_j per realisation: the noise of the period means plus the stochastic
+nonlinear distortion. The noise part alone comes from the periods (2 M (P-1) degrees of
+freedom); their ratio is F(2 (M - q_j), 2 M (P - 1)) without a nonlinearity, and the
+difference estimates the nonlinear level. The regression coefficients are the best linear
+time-periodic approximation (BLA) of the HTF branches, with their total covariance (noise and
+nonlinear distortion) s_j^2 (X^H X)^-1; overlapping branches of neighbouring excited lines are
+estimated jointly rather than leaking into each other.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from . import _core
+from ._validate import as_int, as_positive_float
+from .data import FrequencyData
+
+ALPHA = 0.01
+
+
+@dataclass(frozen=True)
+class DistortionResult:
+    """What :func:`distortion` returns. Levels are variances of one realisation's period mean on
+    each output line (``lines``), in the units of |Y|^2."""
+
+    lines: np.ndarray
+    """Output lines 1 .. max_line."""
+    w: np.ndarray
+    """Their angular frequencies (rad/s)."""
+    kind: np.ndarray
+    """Per line: 'excited', 'sideband' (within +-Kh of an excited line) or 'other'."""
+    signal: np.ndarray
+    """Mean over the realisations of |Y_j|^2."""
+    noise: np.ndarray
+    """Noise variance of a period mean (from the periods, input noise carried through the BLA)."""
+    total: np.ndarray
+    """Residual variance of the regression across realisations: noise + nonlinear distortion."""
+    nonlinear: np.ndarray
+    """max(total - noise, 0): the stochastic nonlinear distortion's variance."""
+    nonlinear_std: np.ndarray
+    """Standard deviation of ``total - noise`` (from their degrees of freedom)."""
+    p_value: np.ndarray
+    """Per line: P(F(2 (M - q), 2 M (P - 1)) > total / noise) (NaN where M <= q)."""
+    dof: np.ndarray
+    """Per line: M - q_j, the realisations left after the regression."""
+    excited: np.ndarray
+    branches: int
+    """Kh: the HTF branches -Kh..Kh regressed."""
+    bla: np.ndarray
+    """(2 Kh + 1, n_excited) complex: branch k (row Kh + k) of the BLA at each excited line; NaN
+    where the output line l + k is outside the lines or has no residual degree of freedom."""
+    bla_var: np.ndarray
+    """Total variance (noise and nonlinear distortion) of each ``bla`` entry."""
+    realisations: int
+    periods: int
+    statistic: float
+    """Over all lines with a residual degree of freedom: the sum of the normal scores of the
+    lines' F ratios over sqrt(count) (standard normal without a nonlinearity)."""
+    p_overall: float
+    """One-sided p-value of ``statistic``."""
+    alpha: float = ALPHA
+
+    @property
+    def detected(self) -> bool:
+        """Nonlinear distortion above the noise (``p_overall`` below ``alpha``)."""
+        return bool(self.p_overall < self.alpha)
+
+    def summary(self) -> str:
+        ok = np.isfinite(self.p_value)
+        out = [f"{self.realisations} realisations x {self.periods} periods, branches -{self.branches}.."
+               f"{self.branches}, {int(ok.sum())} lines tested",
+               f"nonlinear distortion {'DETECTED' if self.detected else 'not detected'} "
+               f"(z = {self.statistic:.2f}, p = {self.p_overall:.2g}, level {self.alpha:g})"]
+        for kind in ("excited", "sideband", "other"):
+            sel = ok & (self.kind == kind)
+            if sel.any():
+                s, n, d = (10 * np.log10(max(float(np.mean(x[sel])), 1e-300))
+                           for x in (self.signal, self.noise, self.nonlinear))
+                out.append(f"{kind:9s} lines ({int(sel.sum())}): signal {s:.1f} dB, noise {n:.1f} dB, "
+                           f"nonlinear {d:.1f} dB (mean powers)")
+        return "\n".join(out)
+
+
+def _as_realisations(x, name):
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 3:
+        raise ValueError(f"{name} must have shape (M, P, N): M realisations of P periods of N samples, "
+                         f"got shape {x.shape}")
+    if x.shape[0] < 2:
+        raise ValueError(f"{name}: at least 2 realisations are needed, got {x.shape[0]}")
+    if x.shape[1] < 2:
+        raise ValueError(f"{name}: at least 2 periods per realisation are needed, got {x.shape[1]}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"{name} contains NaN or inf")
+    return x
+
+
+def _most_regressors(src, lines, Kh):
+    """The largest number of excited lines (and conjugates) within +-Kh of any output line."""
+    srt = np.sort(src)
+    return int(np.max(np.searchsorted(srt, lines + Kh, side="right") - np.searchsorted(srt, lines - Kh)))
+
+
+def _default_branches(src, lines, spacing, M):
+    """The largest Kh (at least spacing - 1, at most 4 spacings) that leaves every line two
+    realisations' worth of residual degrees of freedom (at most M - 2 regressors): the far
+    branches of a time-varying denominator reach the neighbouring excited lines, and a branch
+    left out of the regression would count as nonlinear distortion."""
+    best = max(spacing - 1, 0)
+    for Kh in range(best, 4 * spacing):
+        if _most_regressors(src, lines, Kh) > M - 2:
+            break
+        best = Kh
+    return best
+
+
+def distortion(u, y, *, w0: float, ts: Optional[float] = None, branches: Optional[int] = None,
+               ratio: float = 100.0) -> DistortionResult:
+    """Noise and nonlinear distortion levels per line, and the best linear time-periodic
+    approximation, from M random-phase realisations of one amplitude spectrum.
+
+    Parameters
+    ----------
+    u, y : array_like, shape (M, P, N)
+        M realisations (each its own random phases, the same amplitude spectrum and lines) of
+        P steady-state periods of N samples.
+    w0 : float
+        The period's fundamental (rad/s).
+    ts : float, optional
+        Sample period of a discrete-time system.
+    branches : int, optional
+        Kh, the HTF branches -Kh..Kh regressed per output line. Default: the largest Kh (at
+        least the spacing of the excited lines minus 1) with at most M - 2 excited lines within
+        +-Kh of any line, so that the far branches of neighbouring excited lines are regressed
+        rather than counted as distortion (M = 6 reaches two spacings).
+    ratio : float
+        A line counts as excited when its input power exceeds ``ratio`` times its noise variance
+        in every realisation.
+
+    Returns
+    -------
+    DistortionResult
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import noisy_periods, paper_model
+    >>> m = paper_model()
+    >>> u, y = [], []
+    >>> for r in range(6):                      # 6 realisations, 4 periods each, purely LPTV
+    ...     ms = lptv.multisine(range(10, 241, 10), 2048, seed=r)
+    ...     y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 2048)
+    ...     a, b = noisy_periods(ms.signal, y0, 4, 50, 30, seed=100 + r)
+    ...     u.append(a); y.append(b)
+    >>> d = lptv.distortion(np.array(u), np.array(y), w0=m.w0)
+    >>> d.detected
+    False
+    """
+    u = _as_realisations(u, "u")
+    y = _as_realisations(y, "y")
+    if u.shape != y.shape:
+        raise ValueError(f"u and y must have the same shape, got {u.shape} and {y.shape}")
+    w0 = as_positive_float(w0, "w0")
+    ratio = as_positive_float(ratio, "ratio")
+    M, P, N = u.shape
+    datas = [FrequencyData.from_periods(u[m], y[m], w0=w0, ts=ts) for m in range(M)]
+    L = datas[0].max_line
+    U = np.array([d.U for d in datas])               # (M, L+1)
+    Y = np.array([d.Y for d in datas])
+    varU = np.array([d.varU for d in datas])
+    varY = np.array([d.varY for d in datas])
+    cov = np.array([d.covYU for d in datas])
+    ex_sets = [set(int(x) for x in _core.excited_lines(d._cpp, ratio)) for d in datas]
+    excited = np.array(sorted(set.intersection(*ex_sets)), dtype=int)
+    excited = excited[excited > 0]
+    if excited.size == 0:
+        raise ValueError("u: no line stands above its noise in every realisation")
+    spacing = int(np.min(np.diff(excited))) if excited.size > 1 else L
+    # Regressors of output line j: excited lines c (and -c) with |j - c| <= Kh.
+    src = np.concatenate([excited, -excited])
+    lines = np.arange(1, L + 1)
+    if branches is None:
+        Kh = _default_branches(src, lines, spacing, M)
+    else:
+        Kh = as_int(branches, "branches")
+    Ufull = lambda c: U[:, c] if c >= 0 else np.conj(U[:, -c])           # noqa: E731
+    n = lines.size
+    total = np.full(n, np.nan)
+    noise = np.full(n, np.nan)
+    dof = np.zeros(n, int)
+    bla = np.full((2 * Kh + 1, excited.size), np.nan + 0j)
+    bla_var = np.full((2 * Kh + 1, excited.size), np.nan)
+    ex_index = {int(c): i for i, c in enumerate(excited)}
+    for i, j in enumerate(lines):
+        cs = src[np.abs(j - src) <= Kh]
+        q = cs.size
+        dof[i] = M - q
+        if M - q < 1:
+            continue
+        yj = Y[:, j]
+        if q:
+            X = np.column_stack([Ufull(int(c)) for c in cs])        # (M, q)
+            G, *_ = np.linalg.lstsq(X, yj, rcond=None)
+            r = yj - X @ G
+        else:
+            X, G, r = None, np.zeros(0, complex), yj - 0.0
+        s2 = float(np.sum(np.abs(r) ** 2) / (M - q))
+        # noise of one realisation's period mean: output, plus the input noise through G
+        nv = varY[:, j].copy()
+        for g, c in zip(G, cs):
+            c = int(c)
+            nv = nv + np.abs(g) ** 2 * varU[:, abs(c)]
+            if c == j:
+                nv = nv - 2 * np.real(np.conj(g) * cov[:, j])
+        total[i], noise[i] = s2, float(np.mean(nv))
+        if q:
+            Ci = np.linalg.pinv(X.conj().T @ X)
+            for g, c, v in zip(G, cs, np.real(np.diag(Ci)) * s2):
+                c = int(c)
+                if c > 0:
+                    bla[Kh + (j - c), ex_index[c]] = g
+                    bla_var[Kh + (j - c), ex_index[c]] = v
+    from scipy import stats
+
+    ok = dof >= 1
+    d1 = 2.0 * np.maximum(dof, 1)
+    d2 = 2.0 * M * (P - 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        F = total / noise
+    p = np.where(ok & (noise > 0), stats.f.sf(F, d1, d2), np.nan)
+    diff = total - noise
+    nl = np.where(ok, np.maximum(diff, 0.0), np.nan)
+    nl_std = np.where(ok, np.sqrt(total ** 2 / np.maximum(dof, 1) + noise ** 2 / (M * (P - 1))), np.nan)
+    good = np.isfinite(p)
+    score = stats.norm.isf(np.clip(p[good], 1e-300, 1.0))
+    z = float(score.sum() / np.sqrt(max(score.size, 1)))
+    kind = np.full(n, "other", dtype=object)
+    near = np.zeros(n, bool)
+    for c in excited:
+        near |= np.abs(lines - c) <= Kh
+    kind[near] = "sideband"
+    kind[np.isin(lines, excited)] = "excited"
+    signal = np.mean(np.abs(Y[:, 1:]) ** 2, axis=0)
+    return DistortionResult(
+        lines=lines, w=lines * w0, kind=kind.astype(str), signal=signal, noise=noise, total=total,
+        nonlinear=nl, nonlinear_std=nl_std, p_value=p, dof=dof, excited=excited, branches=Kh,
+        bla=bla, bla_var=bla_var, realisations=M, periods=P, statistic=z,
+        p_overall=float(stats.norm.sf(z)))
