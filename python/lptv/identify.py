@@ -472,7 +472,8 @@ def excited_rows(data: FrequencyData, K: int = 0, ratio: float = 100.0) -> np.nd
 def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
              kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
              lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
-             max_iter: int = 50) -> IdentificationResult:
+             max_iter: int = 50, covariance: str = "analytic", bootstrap: int = 200,
+             seed=None) -> IdentificationResult:
     """Estimate an LPTV model from noisy input/output periods.
 
     Parameters
@@ -513,6 +514,18 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     tol, max_iter :
         WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
         ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
+    covariance : {'analytic', 'bootstrap'}
+        WGTLS, SML: how ``res.covariance`` is obtained. 'analytic' (default): the first-order
+        sandwich of the estimating equation times (P-1)/(P-3) (METHOD.md section 10).
+        'bootstrap': the covariance of ``bootstrap`` refits of data sets drawn from the fitted
+        model and the measured noise (co)variances, P periods each (`lptv.bootstrap`), which
+        follows the randomness of the noise weights at small P where the factor does not
+        (bench/RESULTS.md, "Coverage on three systems"); one data set only, about ``bootstrap``
+        times the cost of the fit.
+    bootstrap : int
+        The number of refits for ``covariance='bootstrap'`` (at least 20).
+    seed : int, optional
+        Seeds the bootstrap's draws.
 
     Raises
     ------
@@ -551,6 +564,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     """
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if not isinstance(covariance, str) or covariance not in ("analytic", "bootstrap"):
+        raise ValueError(f"covariance must be 'analytic' or 'bootstrap', got {covariance!r}")
+    bootstrap = as_int(bootstrap, "bootstrap", minimum=20)
     na, nb = as_int(na, "na"), as_int(nb, "nb")
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter")
@@ -594,6 +610,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
                     + ": its predicted steady state is the periodic solution of its equation, which "
                     "a simulation from rest does not reach (fine for data from a stabilised experiment)")
         warnings.warn(unstable, UnstableModelWarning, stacklevel=2)
+    if covariance == "bootstrap":
+        cov = _bootstrap(r, model, structure, data, several, method, tol, max_iter, bootstrap, seed)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -607,6 +625,36 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
         unstable=unstable, stability_undecided=undecided, structure=structure)
+
+
+def _bootstrap(r, model, structure, data, several, method, tol, max_iter, B, seed):
+    """covariance='bootstrap': the covariance of B refits of parametric bootstrap data sets."""
+    from .bootstrap import bootstrap_covariance
+
+    if several:
+        raise ValueError("covariance='bootstrap' takes one data set, not a list of experiments")
+    if method not in ("wgtls", "sml"):
+        raise ValueError(f"covariance='bootstrap' is for method 'wgtls' or 'sml', got {method!r}")
+    if data.periods < 2 or r.noise_free:
+        raise ValueError("covariance='bootstrap' needs noise statistics from P >= 2 periods")
+    rows = [int(x) for x in r.rows]
+    eta_names = tuple(r.eta_names)
+
+    def fit(d):
+        rb = _core.identify(d._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter),
+                            rows=rows, covariance=False)
+        return np.asarray(rb.eta)
+
+    class _Res:   # what bootstrap_covariance reads of the estimate
+        pass
+
+    est = _Res()
+    est.model = model
+    cov = bootstrap_covariance(est, data, fit, B, seed)
+    norm = [i for i, n in enumerate(eta_names) if np.allclose(cov[i], 0.0)]
+    for i in norm:
+        cov[i, :] = cov[:, i] = 0.0
+    return cov
 
 
 def _experiment_rows(datas, lines, K):
