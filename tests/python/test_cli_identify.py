@@ -389,3 +389,21 @@ def test_lines_beyond_int_give_one_line_error(lines, text, tmp_path, capsys):
                                 "--out", tmp_path / "o")
     _check_one_line_error(rc, out, err, src, text)
     assert not (tmp_path / "o").exists()
+
+
+def test_bootstrap_covariance_option(small, tmp_path, capsys):
+    """--covariance bootstrap gives the Python API's bootstrap covariance (same seed) in
+    model.json; with several files it is refused in one line."""
+    u, y = small
+    src = tmp_path / "dt.npz"
+    np.savez(src, u=u, y=y)
+    rc, out, err = identify_cli(capsys, src, "--na", 1, "--nb", 0, "--ts", TS, "--method", "sml",
+                                "--covariance", "bootstrap", "--bootstrap", 40, "--out", tmp_path / "o")
+    assert rc == 0, err
+    ref = lptv.identify(u, y, na=1, nb=0, w0=W0_SMALL, ts=TS, method="sml", covariance="bootstrap",
+                        bootstrap=40, seed=0)
+    model = lptv.Model.load(tmp_path / "o" / "model.json")
+    np.testing.assert_allclose(model.covariance, ref.covariance, rtol=1e-9, atol=0)
+    rc, out, err = identify_cli(capsys, src, src, "--na", 1, "--nb", 0, "--ts", TS,
+                                "--covariance", "bootstrap")
+    assert rc == 2 and "one record at a time" in err and err.count("\n") == 1

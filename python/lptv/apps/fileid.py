@@ -174,6 +174,11 @@ def add_parser(sub):
                    "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
                    "judges every row that reads a line with signal")
     p.add_argument("--method", default="wgtls", choices=METHODS, help="estimator (default wgtls)")
+    p.add_argument("--covariance", default="analytic", choices=("analytic", "bootstrap"),
+                   help="WGTLS/SML parameter covariance: the analytic sandwich (default) or a parametric "
+                   "bootstrap of --bootstrap refits (one record; better calibrated at few periods)")
+    p.add_argument("--bootstrap", type=int, default=200, metavar="B",
+                   help="refits for --covariance bootstrap (default 200)")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
@@ -196,7 +201,7 @@ def _one_line(problem) -> str:
 
 OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_iter": "--max-iter",
                 "tol": "--tol", "lines": "--lines", "known": "--known", "method": "--method", "w0": "--w0",
-                "ts": "--ts", "periods": "--periods"}
+                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap"}
 """The arguments of lptv.identify and the options that set them, for the messages."""
 
 
@@ -208,6 +213,11 @@ def _fail(name, problem) -> int:
 # ------------------------------------------------------------------------------ running
 
 def run(args) -> int:
+    if args.covariance != "analytic" and (args.joint or len(args.files) > 1 or args.workers is not None
+                                          or args.scheduler is not None):
+        print("lptv identify: error: --covariance bootstrap takes one record at a time (not several files, "
+              "--joint, --workers or --scheduler)", file=sys.stderr)
+        return 2
     if args.joint:
         from lptv.apps import jointid
 
@@ -243,7 +253,8 @@ def run(args) -> int:
             warnings.simplefilter("always")
             res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
-                           max_iter=args.max_iter)
+                           max_iter=args.max_iter, covariance=args.covariance, bootstrap=args.bootstrap,
+                           seed=0)
             Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
