@@ -353,7 +353,9 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
     """The nonparametric HTF branches |G_k| in dB against frequency with +-2 standard deviations
     (a :class:`lptv.HtfEstimate`), and, given a model, its branches on top (lines through the same
     frequencies). Branches whose p-value says they stand above the noise are drawn solid, the
-    others faint.
+    others faint; entries that the far branches of neighbouring excited lines overlap
+    (``est.overlapped``: the ratio there is biased by more than a fraction of its noise) are
+    crosses, and a model should be compared on the other entries only.
 
     Parameters
     ----------
@@ -398,8 +400,13 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
         lo = _db(np.maximum(mag - 2 * est.std[i], floor))
         hi = _db(mag + 2 * est.std[i])
         ax.fill_between(x, lo, hi, color=color, alpha=0.15 * alpha, lw=0)
-        ax.plot(x, _db(mag), "o", ms=3.5, mfc="none", color=color, alpha=alpha,
+        over = est.overlapped[i] if est.overlapped is not None else np.zeros(mag.size, bool)
+        ax.plot(x[~over], _db(mag[~over]), "o", ms=3.5, color=color, alpha=alpha,
                 label=f"G_{k:+d} (data)" if k else "G_0 (data)")
+        if over.any():
+            ax.plot(x[over], _db(mag[over]), "x", ms=4.5, color=color, alpha=alpha)
+    if est.overlapped is not None and est.overlapped.any():
+        ax.plot([], [], "x", color="0.3", label="overlapped by neighbours' branches (biased)")
         if G_model is not None:
             ax.plot(x, _db(G_model[i]), "-", lw=1.0, color=color, alpha=alpha)
     if G_model is not None:
