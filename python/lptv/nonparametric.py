@@ -208,6 +208,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
                        leakage=leak, overlapped=leak > OVERLAP_LEVEL * std)
 
 
+REACH = 32
 OVERLAP_LEVEL = 0.3
 """An entry is flagged as overlapped when its leakage bound exceeds this many standard
 deviations (the bound extrapolates from measured branches and falls short near a resonance)."""
@@ -238,22 +239,25 @@ def _leakage(G, std, lines, Kh, absU):
             med = float(np.nanmedian(ratio)) if np.sum(both) >= 3 else np.nan
             med = med if np.isfinite(med) and med < 1.0 else 0.0
             q[sgn] = np.where(np.isfinite(ratio) & (ratio < 1.0), ratio, med)
-    for i, l in enumerate(lines):
+    absG = np.where(sig, np.abs(G), 0.0)                 # branches that stand above the noise
+    idx = np.arange(n)
+    # neighbours up to REACH excited lines away on each side (further ones are beyond any
+    # measured decay's reach at the accuracy a bound needs, and the cost stays linear in n)
+    for o in range(-min(REACH, n - 1), min(REACH, n - 1) + 1):
+        if o == 0:
+            continue
+        i = idx[(idx + o >= 0) & (idx + o < n)]
+        j = i + o
         for kk in range(2 * Kh + 1):
-            m = l + kk - Kh
-            total = 0.0
-            for j, lp in enumerate(lines):
-                if j == i:
-                    continue
-                d = m - lp
-                if abs(d) <= Kh:
-                    g = abs(G[Kh + d, j]) if sig[Kh + d, j] else 0.0
-                elif Kh >= 1:
-                    sgn = 1 if d > 0 else -1
-                    base = abs(G[Kh + sgn * Kh, j]) if sig[Kh + sgn * Kh, j] else 0.0
-                    g = base * q[sgn][j] ** (abs(d) - Kh)
-                else:
-                    g = 0.0
-                total += g * absU[j]
-            leak[kk, i] = total / absU[i] if absU[i] > 0 else 0.0
+            d = lines[i] + (kk - Kh) - lines[j]             # branch d of neighbour j reaches entry i
+            g = np.zeros(i.size)
+            near = np.abs(d) <= Kh
+            g[near] = absG[(d + Kh)[near], j[near]]
+            if Kh >= 1:
+                for sgn in (1, -1):
+                    far = (np.sign(d) == sgn) & ~near
+                    g[far] = absG[Kh + sgn * Kh, j[far]] * q[sgn][j[far]] ** (np.abs(d[far]) - Kh)
+            leak[kk, i] += g * absU[j]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        leak = np.where(absU[None, :] > 0, leak / absU[None, :], 0.0)
     return leak
