@@ -69,7 +69,8 @@ class ResidueTests:
     """Per row of the fit: the normal score of its normalised residue after the fit's shrinkage
     (NaN for rows not judged)."""
     leverage: np.ndarray
-    """Per row of the fit: 1 - E|e_l|^2 / var e_l after the fit (its share of the parameters)."""
+    """Per row of the fit: 1 - E|e_l|^2 / var e_l after the fit (its share of the parameters),
+    with the fit's projection taken over the judged rows (NaN for the others)."""
     alpha: float = ALPHA
 
     @property
@@ -135,20 +136,23 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         idx = np.flatnonzero(experiment == e)
         if idx.size == 0:
             continue
-        like = _core.ExactLikelihood(d._cpp, par, [int(x) for x in lines[idx]])
+        # Only the rows with signal enter: the others carry no information on the model (and
+        # nearly no leverage), and the dense residue covariance costs O(rows^2)
+        P = int(d.periods)
+        sig = _signal_lines(d, P)
+        rows_e = np.sort(lines[idx])
+        near = np.zeros(rows_e.size, bool)
+        for k in range(-K, K + 1):
+            near |= sig[np.clip(rows_e + k, 0, d.max_line)]
+        keep = rows_e[near] if near.any() else rows_e
+        like = _core.ExactLikelihood(d._cpp, par, [int(x) for x in keep])
         srt = np.asarray(like.sorted_rows)
         pos = {int(l): int(i) for l, i in zip(lines[idx], idx)}
         order.append(np.array([pos[int(l)] for l in srt]))
         S_blocks.append(np.asarray(like.residue_covariance(theta)))
         J_blocks.append(_real_jacobian(np.asarray(_core.jacobian(d._cpp, par, [int(l) for l in srt])), T, free))
-        P = int(d.periods)
         nus.append(np.full(srt.size, 2.0 * (P - 1) if P >= 2 else np.inf))
-        sig = _signal_lines(d, P)
-        near = np.zeros(srt.size, bool)
-        for k in range(-K, K + 1):
-            i = np.clip(srt + k, 0, d.max_line)
-            near |= sig[i]
-        signal_rows.append(near)
+        signal_rows.append(np.ones(srt.size, bool))
         ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
         offsets.append(_offset_groups(srt, ex))
     if not order:
@@ -216,12 +220,15 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     for rank, i in enumerate(srt):
         run = max(run, min(1.0, (k - rank) * p[i]))
         adj[i] = run
-    inv = np.empty(m, int)
-    inv[order] = np.arange(m)
     out_tests = tuple(ResidueTest(name=t[0], rows=np.sort(lines[order[t[1]]]), statistic=t[2], p_value=t[3],
                                   p_holm=float(adj[i])) for i, t in enumerate(tests))
-    score_rows = np.where(judged, score, np.nan)[inv]
-    return ResidueTests(tests=out_tests, judged=judged[inv], score=score_rows, leverage=(1.0 - shrink)[inv])
+    judged_all = np.zeros(lines.size, bool)
+    judged_all[order] = judged
+    score_all = np.full(lines.size, np.nan)
+    score_all[order] = np.where(judged, score, np.nan)
+    lev_all = np.full(lines.size, np.nan)
+    lev_all[order] = 1.0 - shrink
+    return ResidueTests(tests=out_tests, judged=judged_all, score=score_all, leverage=lev_all)
 
 
 def _offset_groups(rows: np.ndarray, excited: np.ndarray) -> np.ndarray:

@@ -86,9 +86,11 @@ def test_leverage_sums_to_half_the_parameters_for_an_lti_model():
     y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
     u, y = noisy_periods(ms.signal, y1, 8, 40, 30, seed=3)
     res = lptv.identify(u, y, na=2, nb=1, w0=0.1, method="wgtls")
-    lev = res.residue_tests.leverage
+    t = res.residue_tests
+    lev = t.leverage[t.judged]                  # the projection is over the judged rows
+    assert res.lines[t.judged].max() <= 60 < res.lines.max()   # the noise-only rows left out
     assert lev.sum() == pytest.approx(res.n_free_parameters / 2, rel=1e-8)
-    assert np.all((lev > 0) & (lev < 1))
+    assert np.all((lev > 0) & (lev < 1)) and np.all(np.isnan(t.leverage[~t.judged]))
 
 
 def test_residue_tests_with_known_coefficients_and_no_noise():
