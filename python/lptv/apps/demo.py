@@ -94,6 +94,7 @@ def run(args) -> int:
     lo, hi = wg.fraction_band
     _say(f"  residues     {100 * wg.fraction_above_0db:.1f} % above 0 dB "
          f"(expected {100 * wg.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %)")
+    _say(f"  verdict      WGTLS: {wg.verdict}; SML: {sm.verdict}")
 
     # --- predicted output against the noise (Fig. 4) ---
     lines = PAPER_ID_LINES
