@@ -266,7 +266,7 @@ def distortion(u, y, *, w0: float, ts: Optional[float] = None, branches: Optiona
     if branches is None:
         Kh = _default_branches(src, lines, spacing, M)
     else:
-        Kh = as_int(branches, "branches")
+        Kh = as_int(branches, "branches", maximum=L)
     Ufull = lambda c: U[:, c] if c >= 0 else np.conj(U[:, -c])           # noqa: E731
     n = lines.size
     total = np.full(n, np.nan)

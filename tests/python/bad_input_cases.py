@@ -488,6 +488,40 @@ def python_cases():
           Case("HtfEstimate.branch-k-str", "type", lambda: htfe().branch("x"), match=names("k")),
           Case("HtfEstimate.significant-alpha-nan", "nan/inf", lambda: htfe().significant(NaN), match=names("alpha"))]
 
+    @functools.lru_cache(maxsize=1)
+    def realisations():
+        """3 random-phase realisations x 2 periods of a first-order system, lines 3, 6, 9, 12."""
+        m = lp().Model([[2.0], [1.0]], [[1.0]], w0=1.0)
+        rng = np.random.default_rng(5)
+        u, y = [], []
+        for r in range(3):
+            ms = lp().multisine([3, 6, 9, 12], 64, seed=r)
+            y0 = lp().time_signal(lp().simulate(m, ms.spectrum), 64)
+            u.append(np.tile(ms.signal, (2, 1)) + 1e-3 * rng.standard_normal((2, 64)))
+            y.append(np.tile(y0, (2, 1)) + 1e-3 * rng.standard_normal((2, 64)))
+        return np.array(u), np.array(y)
+
+    def dist(**kw):
+        u, y = realisations()
+        return lp().distortion(kw.pop("u", u), kw.pop("y", y), **{"w0": 1.0, **kw})
+
+    C += family("distortion", "w0", lambda v: dist(w0=v), FLOAT_BAD)
+    C += family("distortion", "ratio", lambda v: dist(ratio=v), FLOAT_BAD)
+    C += family("distortion", "branches", lambda v: dist(branches=v), [f for f in INT_BAD if f[0] != "none"])
+    C += [Case("distortion-u-2d", "shape", lambda: dist(u=np.zeros((2, 64))), match=names("u")),
+          Case("distortion-u-one-realisation", "size", lambda: dist(u=realisations()[0][:1], y=realisations()[1][:1]),
+               match=names("u")),
+          Case("distortion-y-nan", "nan/inf", lambda: dist(y=np.full((3, 2, 64), NaN)), match=names("y")),
+          Case("distortion-y-shape", "shape", lambda: dist(y=realisations()[1][:, :, :32]), match=r"same shape"),
+          Case("DistortionResult.nonlinear_smooth-width-str", "type", lambda: dist().nonlinear_smooth("x"),
+               match=names("width")),
+          Case("DistortionResult.experiments-width-negative", "range", lambda: dist().experiments(-1),
+               match=names("width")),
+          Case("identify-covariance-bogus", "value", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               covariance="jackknife"), match=names("covariance")),
+          Case("identify-bootstrap-5", "range", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               covariance="bootstrap", bootstrap=5), match=names("bootstrap"))]
+
     C += family("floquet", "tol", lambda v: lp().floquet(ltv(), tol=v), FLOAT_BAD)
     C += family("floquet", "min_truncation", lambda v: lp().floquet(ltv(), min_truncation=v), INT_BAD)
     C += family("floquet", "max_truncation", lambda v: lp().floquet(ltv(), max_truncation=v), INT_BAD)
@@ -741,6 +775,9 @@ def cli_cases():
     for v in ("abc", "a1=nan", "a9=1", "q1=1", "a1=1,a1=2"):
         add(f"identify-known-{v}", ok + ("--known", v), "--known")
     add("identify-method-bogus", ok + ("--method", "ml"), "--method")
+    add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
+    for v in ("5", "abc") + big:
+        add(f"identify-bootstrap-{v}", ok + ("--bootstrap", v), "--bootstrap")
     add("identify-out-proc", ok + ("--out", "/proc/nope"), "/proc/nope")
     add("identify-workers-0", ok + ("--workers", "0"), "--workers")
     add("identify-workers-abc", ok + ("--workers", "abc"), "--workers")
