@@ -210,7 +210,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         mask = judged & (groups == g)
         if mask.any() and not np.array_equal(mask, judged):
             t = stat(mask)
-            tests.append((f"rows {g} lines from the nearest excited line", mask, t, float(stats.norm.sf(t))))
+            tests.append((f"rows {g} line{'' if g == 1 else 's'} from the nearest excited line", mask, t, float(stats.norm.sf(t))))
     # Holm's step-down adjustment.
     p = np.array([t[3] for t in tests])
     k = p.size
