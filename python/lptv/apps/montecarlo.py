@@ -127,6 +127,12 @@ def run(args) -> int:
         integer(args.seed, "--seed", maximum=2**63)
         integer(args.multisine_seed, "--multisine-seed", maximum=2**63)
         output_folder(args.out)
+        # the tables need pandas (and Parquet pyarrow): checked before any fit runs, not after
+        from lptv.batch.executors import require
+
+        require("pandas", "lptv montecarlo's tables")
+        if args.format == "parquet":
+            require("pyarrow", "--format parquet")
         model, ms, lines, what = _design(args)
         executor, workers = executor_of(args)
         print(f"lptv montecarlo: {what}; {args.runs} runs x {args.method}, P = {args.periods}, "
