@@ -15,6 +15,7 @@ PYBIND11_MODULE(_core, m) {
   });
   bind_model(m);
   bind_multisine(m);
+  bind_multisine_design(m);
   bind_fds(m);
   bind_noise(m);
   bind_structure(m);

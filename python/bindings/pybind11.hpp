@@ -11,6 +11,7 @@ using namespace pybind11::literals;
 
 void bind_model(py::module_& m);
 void bind_multisine(py::module_& m);
+void bind_multisine_design(py::module_& m);
 void bind_fds(py::module_& m);
 void bind_noise(py::module_& m);
 void bind_structure(py::module_& m);

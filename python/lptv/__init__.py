@@ -4,6 +4,8 @@ The public API:
 
 - :class:`Model` - the LPTV model (and LTI as its special case), JSON save/load;
 - :func:`multisine`, :func:`spectrum`, :func:`time_signal` - excitation and spectra;
+- :func:`min_crest_multisine`, :func:`schroeder_multisine`, :func:`excitation_lines`,
+  :func:`multisine_realisations` - excitation design (crest factor, detection lines, realisations);
 - :func:`simulate`, :func:`htf`, :func:`band_matrices` - the frequency-domain simulator;
 - :class:`FrequencyData`, :func:`identify` - noise model and estimators (LS, TLS, GTLS, WGTLS,
   SML on the exact likelihood) with the covariance of the estimate;
@@ -30,7 +32,8 @@ from .measurements import Measurements, RecordCheck, RecordWarning, check_record
 from .model import Model
 from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
-from .multisine import Multisine, multisine, spectrum, time_signal
+from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
+                        multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 
 __version__ = "0.1.0"
@@ -42,4 +45,6 @@ __all__ = [
     "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",
     "select", "SelectionResult", "simulate", "spectrum", "time_signal", "check_record", "RecordCheck", "RecordWarning",
     "lti_table", "parameter_table", "compare", "freqresp_band",
+    "CrestDesign", "ExcitationLines", "excitation_lines", "min_crest_multisine", "multisine_realisations",
+    "schroeder_multisine",
 ]

@@ -313,6 +313,61 @@ def python_cases():
         Case("spectrum-x-nan", "nan/inf", lambda: lp().spectrum([0.0, NaN]), match=names("x")),
         Case("spectrum-x-complex", "type", lambda: lp().spectrum([1j, 1.0]), match=names("x")),
     ]
+    # excitation design
+    C += family("min_crest_multisine", "n_samples", lambda v: lp().min_crest_multisine([1, 2], v), INT_BAD)
+    C += family("min_crest_multisine", "oversample", lambda v: lp().min_crest_multisine([1, 2], 16, oversample=v),
+                INT_BAD + [("zero", 0, "range")], skip=("none",))
+    C += family("min_crest_multisine", "max_p", lambda v: lp().min_crest_multisine([1, 2], 16, max_p=v),
+                INT_BAD + [("three", 3, "range"), ("not-power-of-two", 24, "value")])
+    C += family("min_crest_multisine", "iterations_per_p",
+                lambda v: lp().min_crest_multisine([1, 2], 16, iterations_per_p=v), INT_BAD)
+    C += [
+        Case("min_crest_multisine-lines-repeated", "value", lambda: lp().min_crest_multisine([2, 2], 16),
+             match=names("lines")),
+        Case("min_crest_multisine-lines-range", "range", lambda: lp().min_crest_multisine([1, 9], 16),
+             match=names("lines")),
+        Case("min_crest_multisine-amplitudes-zero", "value",
+             lambda: lp().min_crest_multisine([1, 2], 16, amplitudes=0.0), match=names("amplitudes")),
+        Case("min_crest_multisine-amplitudes-nan", "nan/inf",
+             lambda: lp().min_crest_multisine([1, 2], 16, amplitudes=[1.0, NaN]), match=names("amplitudes")),
+        Case("min_crest_multisine-start-unknown", "value",
+             lambda: lp().min_crest_multisine([1, 2], 16, start="clip"), match=names("start")),
+        Case("min_crest_multisine-seed-with-schroeder", "value",
+             lambda: lp().min_crest_multisine([1, 2], 16, seed=1), match=names("seed")),
+        Case("min_crest_multisine-seed-str", "type",
+             lambda: lp().min_crest_multisine([1, 2], 16, start="random", seed="x"), match=names("seed")),
+        Case("min_crest_multisine-value", "value", lambda: lp().min_crest_multisine(range(1, 21), 256),
+             check=lambda ms: ms.crest_factor < 1.6 and np.allclose(np.abs(ms.spectrum[1:21]), 0.5)),
+        Case("schroeder_multisine-amplitudes-zero", "value",
+             lambda: lp().schroeder_multisine([1, 2], 16, amplitudes=0.0), match=names("amplitudes")),
+        Case("schroeder_multisine-lines-str", "type", lambda: lp().schroeder_multisine("abc", 16),
+             match=names("lines")),
+        Case("schroeder_multisine-value", "value", lambda: lp().schroeder_multisine(range(1, 51), 1024),
+             check=lambda ms: 1.65 < ms.crest_factor < 1.8),
+        Case("multisine_realisations-lines-empty", "size", lambda: lp().multisine_realisations([], 16, 2),
+             match=names("lines")),
+        Case("multisine_realisations-seed-str", "type",
+             lambda: lp().multisine_realisations([1], 16, 2, seed="x"), match=names("seed")),
+        Case("excitation_lines-kind-unknown", "value", lambda: lp().excitation_lines(1, 50, kind="even"),
+             match=names("kind")),
+        Case("excitation_lines-last-below-first", "range", lambda: lp().excitation_lines(50, 10),
+             match=names("last")),
+        Case("excitation_lines-group-one", "range", lambda: lp().excitation_lines(1, 50, group=1),
+             match=names("group")),
+        Case("excitation_lines-no-multiple", "value", lambda: lp().excitation_lines(1, 4, reach=3),
+             match=names("reach")),
+        Case("excitation_lines-value", "value", lambda: lp().excitation_lines(1, 30, kind="odd-odd"),
+             check=lambda d: d.excited.tolist() == [1, 5, 9, 13, 17, 21, 25, 29]),
+        Case("ExcitationLines.role-str", "type", lambda: lp().excitation_lines(1, 30).role("x"),
+             match=names("line")),
+        Case("CrestDesign-value", "value",
+             lambda: lp().min_crest_multisine(range(1, 11), 64, return_design=True)[1],
+             check=lambda d: isinstance(d, lp().CrestDesign) and d.crest_factor <= d.initial_crest_factor),
+    ]
+    C += family("multisine_realisations", "M", lambda v: lp().multisine_realisations([1, 2], 16, v),
+                INT_BAD + [("zero", 0, "range")])
+    C += family("excitation_lines", "reach", lambda v: lp().excitation_lines(1, 50, reach=v), INT_BAD)
+    C += family("excitation_lines", "first", lambda v: lp().excitation_lines(v, 50), INT_BAD + [("zero", 0, "range")])
     C += family("time_signal", "n_samples", lambda v: lp().time_signal([1.0, 0.5], v), INT_BAD)
     C += [
         Case("time_signal-X-str", "type", lambda: lp().time_signal("abc", 8), match=names("X")),

@@ -10,7 +10,7 @@ It reads a model's coefficient arrays and never calls the core's computations.
   residue covariance S, cost r^T S^-1 r and its gradient), its minimiser and the Cramer-Rao
   bound, all dense.
 """
-from . import identification, likelihood
+from . import excitation, identification, likelihood
 from .fds import (
     band_matrix_A,
     band_matrix_B,
@@ -28,7 +28,7 @@ from .fds import (
 )
 
 __all__ = [
-    "identification", "likelihood", "band_matrix_A", "band_matrix_B", "coefficients_at",
+    "excitation", "identification", "likelihood", "band_matrix_A", "band_matrix_B", "coefficients_at",
     "crest_factor", "full_spectrum", "grid", "htf", "line_variable", "multisine_spectrum",
     "samples_per_period", "simulate", "spectrum", "time_signal",
 ]
