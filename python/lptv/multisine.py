@@ -67,15 +67,7 @@ def multisine(lines, n_samples: int, amplitudes=1.0, seed=None) -> Multisine:
     np.float64(0.5)
     """
     ln, amp, n_samples = _lines_amplitudes(lines, n_samples, amplitudes)
-    rng = as_seed(seed)
-    phases = rng.uniform(0.0, 2 * np.pi, ln.size)
-    real = (ln == 0) | ((n_samples % 2 == 0) & (ln == n_samples // 2))
-    phases[real] = np.where(np.cos(phases[real]) >= 0, 0.0, np.pi)
-    X = np.asarray(_core.multisine_spectrum([int(x) for x in ln], np.ascontiguousarray(amp),
-                                            phases, n_samples))
-    x = np.asarray(_core.time_signal(X, n_samples))
-    return Multisine(lines=ln, amplitudes=np.array(amp), phases=phases, n_samples=n_samples,
-                     spectrum=X, signal=x)
+    return _build(ln, amp, as_seed(seed).uniform(0.0, 2 * np.pi, ln.size), n_samples)
 
 
 def _lines_amplitudes(lines, n_samples, amplitudes):
@@ -167,6 +159,8 @@ def _has_big_int(x) -> bool:
 # -- excitation design (METHOD.md section 2, "Designing the excitation") ----------------------
 
 def _build(ln, amp, phases, n_samples) -> Multisine:
+    """The multisine of these lines, amplitudes and phases; on DC and the Nyquist line the phase
+    becomes 0 or pi, the sign of its cosine (see :func:`multisine`)."""
     real = (ln == 0) | ((n_samples % 2 == 0) & (ln == n_samples // 2))
     phases = np.array(phases, dtype=float)
     phases[real] = np.where(np.cos(phases[real]) >= 0, 0.0, np.pi)
