@@ -10,6 +10,7 @@ The public API:
 - :class:`FrequencyData`, :func:`identify` - noise model and estimators (LS, TLS, GTLS, WGTLS,
   SML on the exact likelihood) with the covariance of the estimate;
 - :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
+- :func:`identify_record` - one non-periodic record with its transient;
 - :func:`htf_estimate` - the harmonic transfer function's branches from data, without a model;
 - :func:`select` - the orders and harmonic count from the data (a ranked grid of structures);
 - :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
@@ -26,6 +27,7 @@ from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, ide
 from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
 from .distortion import DistortionResult, distortion
+from .record import RecordResult, identify_record
 from .floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
 from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
@@ -46,5 +48,5 @@ __all__ = [
     "select", "SelectionResult", "simulate", "spectrum", "time_signal", "check_record", "RecordCheck", "RecordWarning",
     "lti_table", "parameter_table", "compare", "freqresp_band",
     "CrestDesign", "ExcitationLines", "excitation_lines", "min_crest_multisine", "multisine_realisations",
-    "schroeder_multisine",
+    "schroeder_multisine", "RecordResult", "identify_record",
 ]

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._validate import as_int
 from .fds import simulate
 from .model import Model
 from .multisine import multisine, time_signal
@@ -369,3 +370,37 @@ def system_measurements(system: str = "paper", seed=0, periods: int = 8) -> dict
     u, y = noisy_periods(ms.signal, y0, periods, seed=rng, **noise)
     return dict(u=u, y=y, w0=model.w0, ts=ts, u0=ms.signal, y0=y0, U0=ms.spectrum, Y0=Y0,
                 model=model, multisine=ms, structure=structure, lines=lines, noise=noise)
+
+
+def transient_record(model: Model, periods: int = 4, noise_std: float = 0.01, seed=None,
+                     state_std: float = 3.0, input_std: float = 1.0):
+    """One record of a discrete-time LPTV model under white noise, from a random initial state.
+
+    ``periods`` whole parameter periods of ``model.samples_per_period`` samples; the input is
+    white Gaussian noise of standard deviation ``input_std`` (not periodic), the initial state
+    (y[0..na-1]) Gaussian of ``state_std``: a start-up transient; white Gaussian noise of
+    ``noise_std`` is added to the output. Returns (u, y), the data :func:`lptv.identify_record`
+    takes. The recursion is a_na(t) y[t+na] = sum_m b_m(t) u[t+m] - sum_{n<na} a_n(t) y[t+n].
+
+    Examples
+    --------
+    >>> from lptv.examples import discrete_model, transient_record
+    >>> u, y = transient_record(discrete_model(), periods=2, seed=0)
+    >>> u.shape, y.shape
+    ((512,), (512,))
+    """
+    if not isinstance(model, Model) or not model.discrete:
+        raise ValueError("model must be a discrete-time lptv.Model (the recursion is in discrete time)")
+    periods = as_int(periods, "periods", minimum=1, maximum=10**6)
+    rng = np.random.default_rng(seed)
+    na, nb = model.na, model.nb
+    N = periods * model.samples_per_period
+    u = input_std * rng.standard_normal(N + nb)
+    y = np.zeros(N + na)
+    y[:na] = state_std * rng.standard_normal(na)
+    A = np.asarray(model.a_at(np.arange(N) * model.ts))
+    B = np.asarray(model.b_at(np.arange(N) * model.ts))
+    for t in range(N - na):
+        rhs = B[t] @ u[t:t + nb + 1] - A[t, :na] @ y[t:t + na]
+        y[t + na] = rhs / A[t, na]
+    return u[:N], y[:N] + noise_std * rng.standard_normal(N)

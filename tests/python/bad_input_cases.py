@@ -313,6 +313,38 @@ def python_cases():
         Case("spectrum-x-nan", "nan/inf", lambda: lp().spectrum([0.0, NaN]), match=names("x")),
         Case("spectrum-x-complex", "type", lambda: lp().spectrum([1j, 1.0]), match=names("x")),
     ]
+    # one record with its transient
+    def rec():
+        from lptv.examples import discrete_model, transient_record
+        m = discrete_model()
+        u, y = transient_record(m, periods=2, noise_std=0.01, seed=0)
+        return m, u, y
+
+    def rec_call(**kw):
+        m, u, y = rec()
+        args = dict(u=u, y=y, na=2, nb=1, ka=[2, 1, 0], kb=[2, 0], w0=m.w0, ts=1.0)
+        args.update(kw)
+        return lp().identify_record(args.pop("u"), args.pop("y"), **args)
+
+    C += [
+        Case("identify_record-u-str", "type", lambda: rec_call(u="abc"), match=names("u")),
+        Case("identify_record-u-nan", "nan/inf", lambda: rec_call(u=np.full(512, NaN)), match=names("u")),
+        Case("identify_record-y-length", "shape", lambda: rec_call(y=np.ones(300)), match=names("y")),
+        Case("identify_record-u-not-whole-periods", "value",
+             lambda: rec_call(u=np.ones(500), y=np.ones(500)), match=names("u")),
+        Case("identify_record-ts-zero", "range", lambda: rec_call(ts=0.0), match=names("ts")),
+        Case("identify_record-ts-str", "type", lambda: rec_call(ts="1"), match=names("ts")),
+        Case("identify_record-w0-negative", "range", lambda: rec_call(w0=-1.0), match=names("w0")),
+        Case("identify_record-noise-unknown", "value", lambda: rec_call(noise="flat"), match=names("noise")),
+        Case("identify_record-noise-negative", "range", lambda: rec_call(noise=-1.0), match=names("noise")),
+        Case("identify_record-lines-zero", "range", lambda: rec_call(lines=[0, 5]), match=names("lines")),
+        Case("identify_record-ka-length", "shape", lambda: rec_call(ka=[1, 1]), match=names("ka")),
+        Case("identify_record-na-zero", "range", lambda: rec_call(na=0), match=names("na")),
+        Case("identify_record-max_iterations-zero", "range", lambda: rec_call(max_iterations=0),
+             match=names("max_iterations")),
+        Case("identify_record-value", "value", lambda: rec_call(),
+             check=lambda r: r.converged and r.periods == 2 and 0.7 < r.cost_ratio < 1.3),
+    ]
     # excitation design
     C += family("min_crest_multisine", "n_samples", lambda v: lp().min_crest_multisine([1, 2], v), INT_BAD)
     C += family("min_crest_multisine", "oversample", lambda v: lp().min_crest_multisine([1, 2], 16, oversample=v),

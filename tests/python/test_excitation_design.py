@@ -189,3 +189,11 @@ def test_detection_lines_see_a_cubic_and_not_the_time_variation():
     assert power(cub, d.odd_detection) > 1e4 * power(lin, d.odd_detection)
     assert d.role(int(d.odd_detection[0])) == "odd nonlinear"
     assert d.role(int(d.excited[0]) + 1) == "LPTV sideband"
+
+
+def test_docstring_examples_run():
+    import doctest
+    import sys
+
+    result = doctest.testmod(sys.modules["lptv.multisine"], optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted >= 8 and result.failed == 0

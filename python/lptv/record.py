@@ -1,0 +1,386 @@
+"""One non-periodic record with its transient (METHOD.md section 17).
+
+``lptv.identify_record(u, y, ...)``: a single record of L whole parameter periods, started from an
+unknown state under an arbitrary input (no repeated periods). On the record's DFT grid (spacing
+w0 / L) the model's harmonic k shifts a spectrum by k L lines, and the transient is a polynomial
+T of degree max(na, nb) with real coefficients (section 17). The output noise level comes from
+the local polynomial method; the model and T are fitted by output-error maximum likelihood
+(the input is taken as exact: one record cannot tell input noise from input), with the
+frequency-domain simulator of the core solving A Y = B U - T for the prediction and its
+Jacobian.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from . import _core
+from ._validate import as_int, as_real_1d
+from .fds import simulate
+from .model import Model
+
+
+@dataclass(frozen=True)
+class RecordResult:
+    """What :func:`identify_record` found."""
+
+    model: Model
+    """The estimated LPTV model (the record's own w0 and ts)."""
+    eta: np.ndarray
+    """Real parameters, named by ``eta_names`` (as ``lptv.identify``: Re a_na,0 = 1, its std 0)."""
+    eta_names: list
+    covariance: np.ndarray
+    """Covariance of ``eta`` (output-error ML: the inverse Fisher information at the estimate)."""
+    parameter_std: np.ndarray
+    transient: np.ndarray
+    """Coefficients c_1..c_n of T(z) = sum c_j z^j (METHOD.md section 17: the record's boundary
+    values weighted by the coefficients); empty without the transient term."""
+    transient_std: np.ndarray
+    periods: int
+    """L: whole parameter periods in the record."""
+    lines: np.ndarray
+    """The record's DFT lines fitted (spacing w0 / L)."""
+    noise_var: np.ndarray
+    """Output noise variance E|V_l|^2 per fitted line (from the residual, the local polynomial
+    method, or given)."""
+    noise_dof: int
+    """Lines behind each line's variance: the residual route's average, or the local polynomial
+    method's complex degrees of freedom (0 when given)."""
+    Y: np.ndarray
+    """Measured output spectrum on ``lines``."""
+    Y_fit: np.ndarray
+    """Predicted output spectrum (with the transient) on ``lines``."""
+    cost: float
+    """sum |Y - Y_fit|^2 / noise_var over the lines: about the number of real residues
+    2 n_lines minus the parameters when the model and the noise level are right."""
+    dof: int
+    """2 n_lines - number of real parameters."""
+    converged: bool
+    iterations: int
+
+    @property
+    def cost_ratio(self) -> float:
+        """cost / dof: about 1 when the model and the noise level fit the data."""
+        return self.cost / self.dof
+
+
+def _record_periods(n_total, n0, name):
+    if n_total % n0:
+        raise ValueError(f"{name} must hold a whole number of parameter periods of {n0} samples, "
+                         f"got {n_total} samples ({n_total / n0:.3f} periods): drop "
+                         f"{n_total % n0} samples at the start")
+    return n_total // n0
+
+
+class _Grid:
+    """The record's DFT grid and the band operators of a coefficient set on it."""
+
+    def __init__(self, N, L, w0, ts):
+        self.N, self.L = N, L
+        self.x = np.exp(2j * np.pi * np.arange(N) / N)          # z_m (discrete time)
+
+    def apply(self, coef, X):
+        """sum_p sum_k coef[p, K+k] x_{l-kL}^p X_{l-kL} on the full grid."""
+        K = (coef.shape[1] - 1) // 2
+        out = np.zeros(self.N, dtype=complex)
+        for p in range(coef.shape[0]):
+            xp = self.x**p * X
+            for k in range(-K, K + 1):
+                c = coef[p, K + k]
+                if c != 0:
+                    out += c * np.roll(xp, k * self.L)
+        return out
+
+    def transient_basis(self, n):
+        """n columns: z^1..z^n (section 17)."""
+        return np.stack([self.x**j for j in range(1, n + 1)], axis=1)
+
+
+def _full(X_one, N):
+    """Full DFT array from lines 0..N//2 of a real signal's spectrum."""
+    full = np.zeros(N, dtype=complex)
+    full[: N // 2 + 1] = X_one
+    idx = np.arange(1, (N + 1) // 2)
+    full[N - idx] = np.conj(X_one[idx])
+    return full
+
+
+def local_polynomial_noise(U, Y, L, lines, *, branches: int, degree: int = 2, half_width: Optional[int] = None,
+                           transient: bool = True):
+    """Output noise variance per line by the local polynomial method on the record's grid.
+
+    On the 2R + 1 lines l + r around line l: Y_{l+r} = sum_{|k|<=branches} P_k(r) U_{l+r-kL} +
+    P_T(r) + V, each P a complex polynomial of ``degree`` (the HTF's branches and the output
+    transient, smooth across lines); the residual's mean square over its 2R + 1 - q complex
+    degrees of freedom is the line's variance, then averaged over the 2R + 1 lines around it
+    (noise spectra are smooth; the average steadies the weights). Returns (variance, dof).
+    """
+    N = U.size
+    q = (2 * branches + 1 + (1 if transient else 0)) * (degree + 1)
+    R = q if half_width is None else half_width
+    if 2 * R + 1 <= q:
+        raise ValueError(f"half_width must leave degrees of freedom: 2 R + 1 > {q}, got R = {R}")
+    r = np.arange(-R, R + 1)
+    powers = np.stack([r.astype(float) ** d for d in range(degree + 1)], axis=1)  # (2R+1, D+1)
+    lo, hi = max(1, int(lines.min()) - 2 * R), min(N // 2, int(lines.max()) + 2 * R)
+    est = {}
+    for l in range(lo, hi + 1):
+        m = (l + r) % N
+        cols = []
+        for k in range(-branches, branches + 1):
+            cols.append(powers * U[(m - k * L) % N][:, None])
+        if transient:
+            cols.append(powers.astype(complex))
+        X = np.concatenate(cols, axis=1)
+        g, *_ = np.linalg.lstsq(X, Y[m], rcond=None)
+        res = Y[m] - X @ g
+        est[l] = np.sum(np.abs(res) ** 2) / (2 * R + 1 - q)
+    var = np.array([np.mean([est[j] for j in range(max(lo, l - R), min(hi, l + R) + 1)]) for l in lines])
+    return var, 2 * R + 1 - q
+
+
+def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float, lines=None, transient: bool = True, noise="residual",
+                    noise_width: int = 10, lpm_branches: Optional[int] = None, lpm_degree: int = 2,
+                    max_iterations: int = 100) -> RecordResult:
+    """Identify an LPTV model from one record (not periodic, with a start-up transient).
+
+    Parameters
+    ----------
+    u, y : array_like, 1-D
+        The record: input and output samples, L whole parameter periods (the start of a longer
+        record can be dropped to make it whole).
+    na, nb, ka, kb
+        The structure, as for :func:`lptv.identify` (ka, kb: a count for all coefficients or one
+        per coefficient).
+    w0 : float
+        The parameter fundamental (rad/s), 2 pi / period.
+    ts : float
+        The sample time of the record and of the discrete-time model (forward shift, as
+        :class:`lptv.Model` with ``ts``); there the transient term is exact. **Discrete time
+        only, for now:** for a continuous-time model the term holds for the continuous signal
+        but the DFT of samples adds the aliasing of the record's jump (section 17); that route
+        is not built.
+    lines : sequence of int, optional
+        The record's DFT lines to fit (spacing w0 / L). Default: 1..N/2 - 1.
+    transient : bool
+        Estimate the transient term (False: the steady-state model alone, biased by the
+        transient; for comparison).
+    noise : {"residual", "lpm"} or float or array
+        The output noise variance E|V_l|^2 per line. ``"residual"`` (default): from the fit's own
+        residual, |Y_l - Y_fit,l|^2 averaged over the 2 ``noise_width`` + 1 lines around l and
+        scaled by 2 n / (2 n - p) for the p parameters fitted to the 2 n real residues, the fit
+        then repeated with those weights (twice); it needs the structure to be right.
+        ``"lpm"``: the local polynomial method (:func:`local_polynomial_noise`), which needs no
+        model but assumes the HTF's branches beyond ``lpm_branches`` negligible and each branch
+        and the output transient locally polynomial over its window: on a strongly time-varying
+        system (far branches decaying slowly) it overestimates the noise (METHOD.md section 17).
+        A number or one per line: the variance, when known.
+    noise_width : int
+        Half width of the residual route's average.
+    lpm_branches : int, optional
+        HTF branches of the local polynomial method (default: the largest harmonic count + 1).
+    lpm_degree : int
+        Degree of its local polynomials.
+    max_iterations : int
+        Bound on the Levenberg-Marquardt iterations.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import discrete_model, DISCRETE_N
+    >>> m = discrete_model()
+    >>> u, y = lptv.examples.transient_record(m, periods=4, noise_std=0.01, seed=1)
+    >>> res = lptv.identify_record(u, y, na=2, nb=1, ka=[2, 1, 0], kb=[2, 0], w0=m.w0, ts=1.0)
+    >>> res.periods, res.converged, 0.7 < res.cost_ratio < 1.3
+    (4, True, True)
+    """
+    u = as_real_1d(u, "u", min_len=2)
+    y = as_real_1d(y, "y", min_len=2)
+    if u.shape != y.shape:
+        raise ValueError(f"u and y must have the same length, got {u.size} and {y.size}")
+    step, name = ts, "ts"
+    if isinstance(step, (bool, np.bool_)) or not (isinstance(step, (int, float, np.floating, np.integer)) and np.isfinite(step) and step > 0):
+        raise ValueError(f"{name} must be a positive number of seconds, got {step!r}")
+    if not (isinstance(w0, (int, float, np.floating, np.integer)) and np.isfinite(w0) and w0 > 0):
+        raise ValueError(f"w0 must be a positive angular frequency (rad/s), got {w0!r}")
+    n0f = 2 * np.pi / (w0 * step)
+    n0 = int(round(n0f))
+    if n0 < 2 or abs(n0f - n0) > 1e-9 * n0f:
+        raise ValueError(f"w0 and {name} must give a whole number of samples per period, "
+                         f"2 pi / (w0 {name}) = {n0f:.6g}")
+    N = u.size
+    L = _record_periods(N, n0, "u")
+    na = as_int(na, "na", minimum=1, maximum=50)
+    nb = as_int(nb, "nb", minimum=0, maximum=50)
+    ka_l = [as_int(ka, "ka", maximum=10**4)] * (na + 1) if np.ndim(ka) == 0 else [as_int(k, "ka", maximum=10**4) for k in ka]
+    kb_l = [as_int(kb, "kb", maximum=10**4)] * (nb + 1) if np.ndim(kb) == 0 else [as_int(k, "kb", maximum=10**4) for k in kb]
+    if len(ka_l) != na + 1:
+        raise ValueError(f"ka must have na + 1 = {na + 1} entries, got {len(ka_l)}")
+    if len(kb_l) != nb + 1:
+        raise ValueError(f"kb must have nb + 1 = {nb + 1} entries, got {len(kb_l)}")
+    max_iterations = as_int(max_iterations, "max_iterations", minimum=1, maximum=10**5)
+    lpm_degree = as_int(lpm_degree, "lpm_degree", maximum=6)
+    par = _core.Parametrisation(na, nb, ka_l, kb_l, [], float(w0), 0.0 if ts is None else float(ts))
+    if lines is None:
+        lines = np.arange(1, N // 2)
+    else:
+        lines = np.unique(np.asarray(lines))
+        if lines.size == 0 or not np.issubdtype(lines.dtype, np.integer):
+            raise ValueError(f"lines must be whole line numbers, got {lines!r}")
+        if lines.min() < 1 or lines.max() > N // 2 - 1:
+            raise ValueError(f"lines must lie in 1..{N // 2 - 1} (the record's grid), got "
+                             f"{lines.min()}..{lines.max()}")
+    grid = _Grid(N, L, float(w0), float(ts))
+    U = np.fft.fft(u) / N
+    Y = np.fft.fft(y) / N
+    kmax = max(ka_l + kb_l)
+    nT = max(na, nb) if transient else 0
+    n_eta = len(par.free_indices)        # the free real parameters (eta without Re a_na,0 = 1)
+    if 2 * lines.size <= n_eta + nT:
+        raise ValueError(f"lines: {lines.size} lines give {2 * lines.size} real equations for "
+                         f"{n_eta + nT} parameters")
+
+    # the noise level
+    noise_width = as_int(noise_width, "noise_width", minimum=1, maximum=10**6)
+    if isinstance(noise, str):
+        if noise not in ("residual", "lpm"):
+            raise ValueError(f"noise must be 'residual', 'lpm' or a variance, got {noise!r}")
+        if noise == "lpm":
+            branches = kmax + 1 if lpm_branches is None else as_int(lpm_branches, "lpm_branches", maximum=10**4)
+            var, noise_dof = local_polynomial_noise(U, Y, L, lines, branches=branches, degree=lpm_degree)
+        else:
+            var, noise_dof = np.ones(lines.size), 0
+    else:
+        if isinstance(noise, (bool, np.bool_)):
+            raise ValueError(f"noise must be 'residual', 'lpm' or a variance, got {noise!r}")
+        try:
+            var = np.broadcast_to(np.asarray(noise, dtype=float), lines.shape).copy() \
+                if np.ndim(noise) == 0 else np.asarray(noise, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"noise must be 'residual', 'lpm' or a variance, got {noise!r}") from None
+        if var.shape != lines.shape or not np.all(np.isfinite(var)) or np.any(var <= 0):
+            raise ValueError(f"noise must be positive and finite, a scalar or one per line "
+                             f"({lines.size}), got shape {np.shape(noise)}")
+        noise_dof = 0
+
+    # coefficient arrays of theta, and the unit directions of eta
+    Ka, Kb = max(ka_l), max(kb_l)
+    params = par.params
+
+    def arrays(theta):
+        a = np.zeros((na + 1, 2 * Ka + 1), dtype=complex)
+        b = np.zeros((nb + 1, 2 * Kb + 1), dtype=complex)
+        for (is_a, order, k), v in zip(params, theta):
+            if is_a:
+                a[order, Ka + k] = v
+            else:
+                b[order, Kb + k] = v
+        return a, b
+
+    Text = np.asarray(par.Text)
+    free = list(par.free_indices)
+    norm = par.norm_index
+    dirs = [arrays(Text[:, i]) for i in free]
+    a_norm, b_norm = arrays(Text[:, norm])
+    V = grid.transient_basis(nT) if nT else np.zeros((N, 0))
+
+    def theta_of(eta):
+        xi = np.zeros(par.n_xi)
+        xi[free] = eta
+        xi[norm] = 1.0
+        return Text @ xi
+
+    # start: the equation error E = A Y - B U + T, linear in eta and c, by weighted least squares
+    E0 = grid.apply(a_norm, Y) - grid.apply(b_norm, U)
+    cols = [grid.apply(ad, Y) - grid.apply(bd, U) for ad, bd in dirs]
+    Mf = np.stack(cols, axis=1) if cols else np.zeros((N, 0))
+    Mf = np.concatenate([Mf, V], axis=1)
+    sc = 1.0 / np.sqrt(var)
+    Mr = np.concatenate([(Mf[lines] * sc[:, None]).real, (Mf[lines] * sc[:, None]).imag])
+    br = -np.concatenate([(E0[lines] * sc).real, (E0[lines] * sc).imag])
+    x0, *_ = np.linalg.lstsq(Mr, br, rcond=None)
+    w = 1.0 / np.sqrt(var / 2.0)          # Re and Im of V_l each have variance var / 2
+
+    def record_model(a):
+        a_rec = np.zeros((na + 1, 2 * Ka * L + 1), dtype=complex)
+        a_rec[:, Ka * L + L * np.arange(-Ka, Ka + 1)] = a
+        return Model(a_rec, [[1.0]], w0=float(w0) / L, ts=ts)
+
+    def one(X):
+        return X[: N // 2 + 1]
+
+    def solve(a, R):
+        """A^-1 R on the record's grid (R: full arrays, columns), by the core's FDS."""
+        R1 = one(R)
+        R1 = R1.copy()
+        R1[0] = R1[0].real
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            Yh = simulate(record_model(a), R1, warn_unstable=False)
+        return Yh
+
+    def predict(x):
+        a, b = arrays(theta_of(x[:n_eta]))
+        R = grid.apply(b, U) - V @ x[n_eta:]
+        return a, b, _full(solve(a, R), N)
+
+    def residual(x):
+        _, _, Yh = predict(x)
+        d = (Y - Yh)[lines] * w
+        return np.concatenate([d.real, d.imag])
+
+    def jacobian(x):
+        a, b, Yh = predict(x)
+        R = np.stack([grid.apply(bd, U) - grid.apply(ad, Yh) for ad, bd in dirs]
+                     + [-V[:, j] for j in range(nT)], axis=1)
+        R1 = solve(a, R)                       # (N/2+1, p): dY/dx on lines 0..N/2
+        D = R1[lines] * w[:, None]
+        return -np.concatenate([D.real, D.imag])
+
+    def fit(x_start):
+        try:
+            return least_squares(residual, x_start, jac=jacobian, method="lm",
+                                 max_nfev=max_iterations * (x_start.size + 1), xtol=1e-12, ftol=1e-12, gtol=1e-12)
+        except _core.NumericalError as e:
+            raise _core.NumericalError(f"the output-error fit met a singular model: {e}") from None
+
+    sol = fit(x0)
+    if isinstance(noise, str) and noise == "residual":
+        # the residual's local mean square, debiased for the parameters, then the fit again
+        n_par = x0.size
+        for _ in range(2):
+            _, _, Yh = predict(sol.x)
+            e2 = np.abs((Y - Yh)[lines]) ** 2
+            c = np.convolve(np.ones(2 * noise_width + 1), np.ones(lines.size), mode="same")
+            var = np.convolve(e2, np.ones(2 * noise_width + 1), mode="same") / c
+            var *= 2 * lines.size / (2 * lines.size - n_par)
+            var = np.maximum(var, 1e-300)
+            w = 1.0 / np.sqrt(var / 2.0)
+            sol = fit(sol.x)
+        noise_dof = 2 * noise_width + 1
+    x = sol.x
+    J = sol.jac
+    cost = float(np.sum(sol.fun**2))
+    try:
+        cov = np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.linalg.pinv(J.T @ J)
+    std = np.sqrt(np.clip(np.diag(cov), 0, None))
+    theta = theta_of(x[:n_eta])
+    a, b = arrays(theta)
+    model = Model(a, b, w0=float(w0), ts=ts)
+    _, _, Yh = predict(x)
+    eta = np.zeros(par.n_xi)
+    eta[free] = x[:n_eta]
+    eta[norm] = 1.0
+    cov_eta = np.zeros((par.n_xi, par.n_xi))
+    cov_eta[np.ix_(free, free)] = cov[:n_eta, :n_eta]
+    return RecordResult(
+        model=model, eta=eta, eta_names=list(par.eta_names), covariance=cov_eta,
+        parameter_std=np.sqrt(np.diag(cov_eta)), transient=x[n_eta:].copy(), transient_std=std[n_eta:], periods=L,
+        lines=lines, noise_var=var, noise_dof=int(noise_dof), Y=Y[lines], Y_fit=Yh[lines], cost=cost,
+        dof=int(2 * lines.size - x.size), converged=bool(sol.success), iterations=int(sol.nfev))
