@@ -90,3 +90,16 @@ def test_readme_excitation_design_example_runs(tmp_path, monkeypatch):
     assert ns["flat"].crest_factor <= 1.5
     assert len(ns["realisations"]) == 6
     assert all(np.allclose(np.abs(r.spectrum[d.excited]), 0.5) for r in ns["realisations"])
+
+
+def test_readme_single_record_example_runs(tmp_path, monkeypatch):
+    """One record: the fit with the transient is near its noise level, the one without is not."""
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
+              if "lptv.identify_record(" in b]
+    assert len(blocks) == 1
+    monkeypatch.chdir(tmp_path)
+    ns = {}
+    exec(compile(blocks[0], "README.md", "exec"), ns)
+    res, steady = ns["res"], ns["steady"]
+    assert res.periods == 4 and res.converged and 0.8 < res.cost_ratio < 1.2
+    assert steady.cost_ratio > 5
