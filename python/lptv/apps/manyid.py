@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import identify_many
-from lptv.apps.fileid import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive
+from lptv.apps.fileid import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive, read_options
 from lptv.apps.options import in_option_terms, integer, output_folder
 from lptv.apps.report import write_json
 from lptv.measurements import FileError
@@ -53,6 +53,13 @@ def _stems(files):
     return out
 
 
+def _read(args) -> dict:
+    """The options that say how to read each file (channels, fs, trim ...), for identify_many."""
+    o = read_options(args)
+    return {k: v for k, v in o.items()
+            if k != "periods" and v is not None and v is not False and not (k == "skip_periods" and v == 0)}
+
+
 def run(args) -> int:
     try:
         lines = parse_lines(args.lines) if args.lines is not None else None
@@ -73,7 +80,8 @@ def run(args) -> int:
         output_folder(args.out)
         result = identify_many(args.files, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts,
                                lines=lines, method=args.method, known=known, tol=args.tol,
-                               max_iter=args.max_iter, periods=args.periods, executor=executor,
+                               max_iter=args.max_iter, periods=args.periods, read=_read(args),
+                               executor=executor,
                                workers=workers)
     except (FileError, ValueError, ImportError, OSError) as e:
         return _error(e)
