@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import read_measurements, select
+from lptv.atomic import atomic_open
 from lptv.apps.fileid import parse_lines, positive
 from lptv.apps.options import bounded_range, in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
@@ -136,7 +137,7 @@ def run(args) -> int:
     print(sel.summary())
     try:
         out.mkdir(parents=True, exist_ok=True)
-        with open(out / "selection.csv", "w", newline="") as f:
+        with atomic_open(out / "selection.csv", "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(sel.rows[0]))
             w.writeheader()
             w.writerows(sel.rows)

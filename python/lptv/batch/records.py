@@ -13,6 +13,7 @@ import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_positive_float
 from ..identify import METHODS, _counts, _known_list, _rows, identify
+from ..atomic import atomic_open, atomic_path
 from ..measurements import Measurements, read_measurements, read_options
 from ..model import Model
 from .executors import Failure, describe_executor, require, run_tasks
@@ -122,9 +123,10 @@ class BatchResult:
         path = Path(as_path(path))
         if path.suffix.lower() == ".parquet":
             require("pyarrow", "writing Parquet")
-            self.table().to_parquet(path, index=False)
+            with atomic_path(path) as tmp:
+                self.table().to_parquet(tmp, index=False)
         elif path.suffix.lower() == ".csv":
-            with open(path, "w", newline="") as f:
+            with atomic_open(path, "w", newline="") as f:
                 w = csv.DictWriter(f, fieldnames=self.columns, restval="")
                 w.writeheader()
                 for r in self.rows:
@@ -187,7 +189,8 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
                   periods: Optional[int] = None, read: Optional[Mapping] = None,
                   names: Optional[Sequence[str]] = None,
                   executor="processes", workers: Optional[int] = None,
-                  chunk_size: Optional[int] = None, progress: Optional[bool] = None) -> BatchResult:
+                  chunk_size: Optional[int] = None, progress: Optional[bool] = None,
+                  checkpoint=None) -> BatchResult:
     """:func:`lptv.identify` on many records, one row of results per record.
 
     A record that cannot be read or fitted (a bad file, NaN in the data, a singular system)
@@ -215,6 +218,10 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
         Row labels (default: the file paths, or 'record i').
     executor, workers, chunk_size, progress :
         Where and how the fits run (:func:`lptv.batch.run_tasks`).
+    checkpoint : str or Path, optional
+        A folder where every finished chunk of records is written as it completes; a rerun
+        with the same records, options and folder fits only the records it lacks
+        (:mod:`lptv.batch.parts`).
 
     Returns
     -------
@@ -247,6 +254,8 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     ts = None if ts is None else as_positive_float(ts, "ts")
     periods = None if periods is None else as_int(periods, "periods", minimum=1)
     read = _read(read)
+    if checkpoint is not None:
+        checkpoint = as_path(checkpoint, "checkpoint")
     names, recs = _names(records, names)
     settings = dict(w0=w0, ts=ts, periods=periods, read=read,
                     fit=dict(na=na, nb=nb, ka=ka_l, kb=kb_l, lines=lines, method=method, known=known,
@@ -254,7 +263,7 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     t0 = time.perf_counter()
     out = run_tasks(identify_record, [(n, _slim(r)) for n, r in zip(names, recs)], settings, executor=executor,
                     workers=workers, chunk_size=chunk_size, progress=progress, desc="identify",
-                    unit="record")
+                    unit="record", checkpoint=checkpoint)
     elapsed = time.perf_counter() - t0
 
     rows, models, eta_names = [], [], []
