@@ -206,6 +206,9 @@ def add_parser(sub):
                    help="batch: fit the files on N local processes (default: all cores; 1: serially)")
     b.add_argument("--scheduler", metavar="ADDRESS",
                    help="batch: fit the files on a Dask cluster, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--resume", action="store_true",
+                   help="batch: complete an interrupted batch from the fits kept in --out/parts/ (a rerun with "
+                        "the same files, options and --out does the same)")
     return p
 
 
@@ -232,6 +235,10 @@ def run(args) -> int:
                                           or args.scheduler is not None):
         print("lptv identify: error: --covariance bootstrap takes one record at a time (not several files, "
               "--joint, --workers or --scheduler)", file=sys.stderr)
+        return 2
+    if args.resume and (args.joint or (len(args.files) == 1 and args.workers is None and args.scheduler is None)):
+        print("lptv identify: error: --resume applies to a batch of files (several files, --workers or "
+              "--scheduler), not to one record or --joint", file=sys.stderr)
         return 2
     if args.joint:
         from lptv.apps import jointid
