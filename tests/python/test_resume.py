@@ -170,3 +170,35 @@ def test_atomic_open_leaves_the_old_file_when_the_writer_fails(tmp_path):
     with atomic_open(target) as f:
         f.write("new")
     assert target.read_text() == "new" and oct(target.stat().st_mode & 0o777) != "0o600"
+
+
+# ------------------------------------------------------------------------------ a cluster's faults
+
+def test_a_dask_worker_killed_mid_study_costs_only_its_chunk(tmp_path):
+    """A LocalCluster worker killed by its pid while the study runs: its chunk runs again on
+    another worker, and the study is complete and identical to the serial one."""
+    distributed = pytest.importorskip("distributed")
+    import threading
+
+    ms = lptv.multisine(range(1, 21), 128, amplitudes=np.sqrt(2 / 20), seed=1)
+    kw = dict(periods=4, runs=600, methods="sml", snr_in_db=50, snr_out_db=30, seed=3, progress=False)
+    parts = tmp_path / "parts"
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
+        box = {}
+        run = threading.Thread(target=lambda: box.update(mc=lptv.montecarlo(
+            MODEL, ms, executor=client, chunk_size=10, checkpoint=parts, **kw)))
+        run.start()
+        deadline = time.monotonic() + 120
+        while (stored_items(parts) or 0) < 40 and run.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        pids = client.run(os.getpid)
+        done_at_kill = stored_items(parts)
+        os.kill(sorted(pids.values())[0], signal.SIGKILL)
+        run.join(timeout=300)
+    assert done_at_kill < kw["runs"], "the study ended before the worker was killed: make it longer"
+    mc = box["mc"]
+    assert all(f["ok"] for f in mc.fits)
+    ref = lptv.montecarlo(MODEL, ms, executor="serial", **kw)
+    pd.testing.assert_frame_equal(mc.table(), ref.table())
+    pd.testing.assert_frame_equal(mc.fit_table(), ref.fit_table())
