@@ -202,3 +202,50 @@ def test_a_dask_worker_killed_mid_study_costs_only_its_chunk(tmp_path):
     ref = lptv.montecarlo(MODEL, ms, executor="serial", **kw)
     pd.testing.assert_frame_equal(mc.table(), ref.table())
     pd.testing.assert_frame_equal(mc.fit_table(), ref.fit_table())
+
+
+CLUSTER = """
+import sys, time, distributed
+if __name__ == "__main__":
+    c = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                 host="127.0.0.1")
+    print(c.scheduler_address, flush=True)
+    time.sleep(600)
+"""
+
+
+def test_a_lost_scheduler_ends_the_study_keeping_the_finished_chunks(tmp_path):
+    """The scheduler and its worker are killed mid-study: one line saying what is kept and how to
+    resume, exit status 1, no tables; --resume (here on local processes) completes the study."""
+    pytest.importorskip("distributed")
+    MODEL.save(tmp_path / "model.json")
+    (tmp_path / "cluster.py").write_text(CLUSTER)
+    cluster = subprocess.Popen([sys.executable, str(tmp_path / "cluster.py")], stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True, start_new_session=True)
+    try:
+        address = cluster.stdout.readline().strip()
+        assert address.startswith("tcp://"), address
+        out = tmp_path / "mc"
+        argv = study_args(out)
+        argv[argv.index("--workers"):argv.index("--workers") + 2] = ["--scheduler", address]
+        p = subprocess.Popen(LPTV + argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 120
+        while parts_in(out) < 3 and p.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert p.poll() is None, "the study ended before the scheduler was killed"
+        os.killpg(cluster.pid, signal.SIGKILL)       # the scheduler, its nanny and worker
+        stdout, stderr = p.communicate(timeout=120)
+    finally:
+        if cluster.poll() is None:
+            os.killpg(cluster.pid, signal.SIGKILL)
+        cluster.wait()
+    kept = stored_items(out / "parts")
+    assert p.returncode == 1, stderr
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
+    assert f"{RUNS - kept} of {RUNS} realisations were lost" in stderr
+    assert f"the {kept} finished are kept in {out / 'parts'}/: rerun the same command with --resume" in stderr
+    assert not (out / "estimates.csv").exists()
+    r = subprocess.run(LPTV + study_args(out, "--resume"), capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and f"resuming: {kept} of {RUNS}" in r.stdout, r.stderr
+    with open(out / "fits.csv") as f:
+        assert sum(row["ok"] == "True" for row in csv.DictReader(f)) == RUNS

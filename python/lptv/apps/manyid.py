@@ -36,8 +36,16 @@ def _error(problem) -> int:
 
 
 def executor_of(args):
-    """(executor, workers) from --workers / --scheduler."""
+    """(executor, workers) from --workers / --scheduler. With a scheduler, the Dask client's own
+    log (a traceback per failed reconnection when the scheduler is lost) is silenced: the command
+    says what was lost and how to resume in one line."""
     if args.scheduler is not None:
+        import contextlib
+        import logging
+
+        with contextlib.suppress(ImportError):
+            import distributed  # noqa: F401 - its import configures its loggers: set the level after
+        logging.getLogger("distributed.client").setLevel(logging.CRITICAL)
         return args.scheduler, None
     if args.workers is not None:
         if args.workers < 1:

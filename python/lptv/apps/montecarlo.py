@@ -191,8 +191,8 @@ def _study(args, model, ms, lines, what, executor, workers, parts, held) -> int:
         overview = mc.overview()
     except (FileError, ValueError, ImportError) as e:
         return _error(e)
-    except OSError as e:
-        return _error(f"{e.filename or args.out}: {e.strerror or e}")
+    except OSError as e:   # a file that cannot be written, or a scheduler that cannot be reached
+        return _error(f"{e.filename}: {e.strerror or e}" if e.filename else e)
     print(mc.report())
     out = Path(args.out)
     write_json(out / "summary.json", {
