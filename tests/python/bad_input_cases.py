@@ -673,7 +673,8 @@ def python_cases():
           Case("identify_many-read-key", "value", lambda: many(read={"channel": "u"}), match=names("read")),
           Case("identify_many-read-periods", "value", lambda: many(read={"periods": 4}), match=names("read")),
           Case("identify_many-read-fs", "range", lambda: many(read={"fs": -1.0}), match=names("read")),
-          Case("identify_many-read-u", "type", lambda: many(read={"u": 3}), match=names("read"))]
+          Case("identify_many-read-u", "type", lambda: many(read={"u": 3}), match=names("read")),
+          Case("identify_many-checkpoint-int", "type", lambda: many(checkpoint=3), match=names("checkpoint"))]
 
     def mc(**kw):
         args = dict(periods=4, runs=1, snr_in_db=40.0, snr_out_db=40.0, executor="serial", progress=False)
@@ -693,7 +694,10 @@ def python_cases():
                                                                         snr_in_db=40, snr_out_db=40),
                match=names("model")),
           Case("montecarlo-excitation-str", "type", lambda: mc(excitation="abc"), match=names("excitation")),
-          Case("montecarlo-methods", "value", lambda: mc(methods="ml"), match=names("methods"))]
+          Case("montecarlo-methods", "value", lambda: mc(methods="ml"), match=names("methods")),
+          Case("montecarlo-checkpoint-int", "type", lambda: mc(checkpoint=3), match=names("checkpoint")),
+          Case("montecarlo-checkpoint-file", "file", lambda: mc(checkpoint=write("a-file", "text")),
+               match=names("checkpoint"))]
 
     # results' methods and plots (matplotlib, the 'plots' extra)
     C += [
@@ -816,6 +820,8 @@ def cli_cases():
     add("identify-output-missing", ok + ("--output", "disp"), "--output")
     add("identify-output-two", ok + ("--output", "y,u"), "--output")
     add("identify-time-missing", ok + ("--time", "clock"), "--time")
+    add("identify-resume-one-file", ok + ("--resume",), "--resume")
+    add("identify-resume-nothing", ok + ("--workers", "1", "--out", "{dir}/batch", "--resume"), "--resume")
     add("identify-na-missing", ("identify", "{dir}/good.npz", "--nb", "0"), "--na")
     # lptv select
     add("select-file-junk", ("select", "{dir}/junk.csv", "--periods", "4"), "junk.csv")
@@ -837,6 +843,9 @@ def cli_cases():
     add("select-workers-0", ("select", "{dir}/good.npz", "--workers", "0"), "--workers")
     add("select-scheduler-not-an-address", sel[:-2] + ("--scheduler", "not an address"), "(scheduler|executor|dask)")
     add("select-out-proc", sel + ("--out", "/proc/nope"), "/proc/nope")
+    add("select-input-missing", sel + ("--input", "force"), "--input")
+    add("select-output-two", sel + ("--output", "y,u"), "--output")
+    add("select-time-missing", sel + ("--time", "clock"), "--time")
     # lptv montecarlo
     for opt, vals in (("--runs", ("0", "-1", "abc", "2147483648")), ("--periods", ("1", "abc", "2147483648")),
                       ("--samples", ("0", "-1", "99999999999")), ("--snr-in", ("nan", "abc")),
@@ -860,6 +869,7 @@ def cli_cases():
     add("montecarlo-excited-without-model", mc + ("--excited", "1-10"), "--excited")
     add("montecarlo-scheduler-not-an-address", mc[:5] + ("--scheduler", "not an address"),
         "(scheduler|executor|dask)")
+    add("montecarlo-resume-nothing", mc + ("--resume",), "--resume")
     add("montecarlo-out-proc", ("montecarlo", "--runs", "1", "--workers", "1", "--out", "/proc/nope"), "/proc/nope")
     # lptv demo
     add("demo-out-proc", ("demo", "--quick", "--out", "/proc/nope"), "/proc/nope")

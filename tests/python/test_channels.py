@@ -202,3 +202,14 @@ def test_a_batch_of_files_reads_the_named_channels(record, reference, tmp_path, 
                              executor="serial", progress=False)
     assert [r["ok"] for r in res.rows] == [True, True]
     np.testing.assert_allclose(res.models[0].a, reference.model.a, rtol=0, atol=1e-12)
+
+
+def test_select_reads_the_named_channels_and_the_time_column(record, tmp_path, capsys):
+    src = rig_csv(tmp_path / "rig.csv", *record)
+    rc = cli.main(["select", str(src), "--input", "force", "--output", "displacement", "--period", str(T0),
+                   "--na", "1", "--nb", "0", "--k", "0", "--refine", "0", "--workers", "1", "--out", str(tmp_path / "s")])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    assert f"{P} periods of {N} samples" in out
+    ref = lptv.identify(*record, na=1, nb=0, w0=W0)
+    assert_same_model(tmp_path / "s" / "model.json", ref)

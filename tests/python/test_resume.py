@@ -183,7 +183,7 @@ def test_a_dask_worker_killed_mid_study_costs_only_its_chunk(tmp_path):
     ms = lptv.multisine(range(1, 21), 128, amplitudes=np.sqrt(2 / 20), seed=1)
     kw = dict(periods=4, runs=600, methods="sml", snr_in_db=50, snr_out_db=30, seed=3, progress=False)
     parts = tmp_path / "parts"
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
                                   host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
         box = {}
         run = threading.Thread(target=lambda: box.update(mc=lptv.montecarlo(

@@ -120,7 +120,8 @@ class Checkpoint:
         try:
             self.dir.mkdir(parents=True, exist_ok=True)
         except OSError as e:
-            raise CheckpointError(f"checkpoint {self.dir}: {e.strerror or e}") from None
+            raise CheckpointError(f"checkpoint {self.dir} is not a folder that can be written: "
+                                  f"{e.strerror or e}") from None
         study = self.dir / STUDY
         if study.exists():
             try:
