@@ -1,10 +1,16 @@
 """Reading periodic measurements from files: CSV, NPZ and MATLAB (v4/v5/v7 and v7.3).
 
-- CSV: a header row naming the columns ``u`` and ``y`` (other columns are ignored), one sample
-  per row, the periods one after another; ``periods`` says how many the record holds.
-- NPZ: arrays ``u`` and ``y`` of shape (P, N), optionally a scalar ``w0`` (rad/s).
-- MATLAB ``.mat`` (v4/v5/v7 via scipy, v7.3 via h5py): variables ``u`` and ``y`` of size P x N,
-  optionally a scalar ``w0``. In NPZ and MAT files, vectors are accepted with ``periods``.
+- CSV: a header row naming the columns (by default ``u`` and ``y``; other columns are ignored),
+  one sample per row, the periods one after another.
+- NPZ: arrays (by default ``u`` and ``y``) of shape (P, N) or one long vector each, optionally
+  a scalar ``w0`` (rad/s).
+- MATLAB ``.mat`` (v4/v5/v7 via scipy, v7.3 via h5py): variables as in NPZ, P x N or vectors.
+
+The channels are named with ``u=`` / ``y=`` (``--input`` / ``--output``). A long record is split
+into periods by ``periods`` or by the sampling frequency and the period; the sampling frequency
+is given (``fs=`` / ``dt=``) or read from the file: a time column or variable (``t``, ``time``,
+``time [s]`` ..., or ``time=``), checked uniform, or a stored scalar ``fs``, ``dt`` or ``Ts``
+(:mod:`lptv.channels`).
 
 Examples
 --------
@@ -22,23 +28,23 @@ import io
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional, Tuple
+from typing import Callable, Optional, Tuple
 
 import numpy as np
 
 from ._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
+from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, find, fs_from_time, listing,
+                       stored_fs, time_unit)
 
 FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
 _MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
                    "int64", "uint64"}
+__all__ = ["FileError", "Measurements", "RecordCheck", "RecordWarning", "check_record", "read_measurements",
+           "samples_per_period"]
 
 
 def _one_line(e):
     return " ".join(str(e).split()) or type(e).__name__
-
-
-class FileError(ValueError):
-    """A problem with the input file or the options that the user can act on (a ValueError)."""
 
 
 @dataclass(frozen=True)
@@ -50,18 +56,39 @@ class Measurements:
     w0: Optional[float]
     format: str
     fs: Optional[float] = None
-    """The sampling frequency (Hz) when it was given; None otherwise."""
+    """The sampling frequency (Hz) when it was given or read from the file; None otherwise."""
     trimmed: int = 0
     """Samples dropped at the start of a long record to keep whole periods (``trim=True``)."""
     skipped: int = 0
     """Whole periods dropped at the start (``skip_periods``)."""
+    input: str = "u"
+    """The file's name of the input channel (column, array or variable)."""
+    output: str = "y"
+    """The file's name of the output channel."""
+    fs_source: Optional[str] = None
+    """Where fs came from: None when given (or unknown), else e.g. "column 'time'" or "variable 'fs'"."""
+
+
+@dataclass
+class _Raw:
+    """What a reader found: the two channels as stored, the file's w0 and sampling frequency."""
+
+    u: np.ndarray
+    y: np.ndarray
+    w0: Optional[float]
+    found: Callable[[], Optional[Tuple[float, str]]]
+    """(fs, where from) of the file itself, or None: computed when asked (an fs given overrides it)."""
+    kind: str                    # "column" or "variable"
+    names: Tuple[str, str]
+    line_of: Optional[list] = None
 
 
 # ------------------------------------------------------------------------------ reading
 
 def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float] = None,
                       dt: Optional[float] = None, period: Optional[float] = None,
-                      trim: bool = False, skip_periods: int = 0) -> Measurements:
+                      trim: bool = False, skip_periods: int = 0, u: Optional[str] = None,
+                      y: Optional[str] = None, time: Optional[str] = None) -> Measurements:
     """Read u, y (shape (P, N)) and an optional w0 from a CSV, NPZ or MATLAB file.
 
     Parameters
@@ -75,7 +102,9 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         discrete. With the period (``period`` or the file's ``w0``) it gives the samples per
         period ``N = fs * period``, which must be an integer: a long record is then split into
         whole periods (``periods`` is not needed, and is checked if given), and a (P, N) array
-        must have that N.
+        must have that N. Without ``fs``, ``dt`` and ``periods``, the file's own sampling
+        frequency is used: its time column or variable (``time``), checked uniformly sampled,
+        or a stored scalar ``fs`` (Hz), ``dt`` or ``Ts`` (s); ``Measurements.fs_source`` says which.
     period : float, optional
         The period in s (used with ``fs``/``dt``; else the file's ``w0`` gives it).
     trim : bool
@@ -84,6 +113,13 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         error that says how many samples to drop.
     skip_periods : int
         Drop this many whole periods at the start (a start-up transient).
+    u, y : str, optional
+        The names of the input and output channels: CSV columns (matched up to case), NPZ
+        arrays or MAT variables (default ``'u'`` and ``'y'``). One output at a time: MIMO
+        models are not supported yet.
+    time : str, optional
+        The name of a time column or variable in s (default: one named ``t`` or ``time``,
+        also with a unit, ``time [s]``, ``t_ms``).
 
     Raises :class:`FileError` with a message naming the problem (not the file).
 
@@ -95,19 +131,23 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     >>> lptv.read_measurements(path, fs=100.0, period=1.0)
     Traceback (most recent call last):
     ...
-    lptv.measurements.FileError: variable 'u' has 1050 samples, 10.5 periods of 100 (fs 100 Hz x period 1 s): drop 50 samples to keep 10 whole periods (or trim=True / --trim)
+    lptv.channels.FileError: variable 'u' has 1050 samples, 10.5 periods of 100 (fs 100 Hz x period 1 s): drop 50 samples to keep 10 whole periods (or trim=True / --trim)
     >>> m = lptv.read_measurements(path, fs=100.0, period=1.0, trim=True, skip_periods=1)
     >>> m.u.shape, m.trimmed, m.skipped
     ((9, 100), 50, 1)
+    >>> t = np.arange(1000) / 100.0                                   # a time column at 100 Hz
+    >>> np.savetxt(os.path.join(d, "r.csv"), np.c_[t, t, t], delimiter=",", header="time,force,disp",
+    ...            comments="")
+    >>> m = lptv.read_measurements(os.path.join(d, "r.csv"), u="force", y="disp", period=1.0)
+    >>> m.u.shape, m.fs, m.fs_source, m.input
+    ((10, 100), 100.0, "column 'time'", 'force')
     """
     path = Path(as_path(path))
-    periods = as_optional(periods, _option, as_int, "--periods", minimum=1)
-    fs = as_optional(fs, _option, as_float, "--fs", minimum=0.0, open_min=True, what="a positive number")
-    dt = as_optional(dt, _option, as_float, "--dt", minimum=0.0, open_min=True, what="a positive number")
-    period = as_optional(period, _option, as_float, "--period", minimum=0.0, open_min=True,
-                         what="a positive number")
-    trim = _option(trim, as_bool, "--trim")
-    skip_periods = _option(skip_periods, as_int, "--skip-periods")
+    o = read_options(periods=periods, fs=fs, dt=dt, period=period, trim=trim, skip_periods=skip_periods,
+                     u=u, y=y, time=time)
+    periods, fs, dt, period, trim, skip_periods = (o[k] for k in ("periods", "fs", "dt", "period", "trim",
+                                                                  "skip_periods"))
+    names = {"u": o["u"] or "u", "y": o["y"] or "y", "time": o["time"]}
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
         raise FileError(f"unknown file type '{path.suffix}' (expected .csv, .npz or .mat)")
@@ -116,25 +156,61 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     if path.is_dir():
         raise FileError("is a directory, not a measurement file")
     fs = _sampling(fs, dt)
-    split = _Split(periods, fs, period, trim)
     if fmt == "CSV":
-        u, y, w0 = _read_csv(path, split)
+        raw = _read_csv(path, names)
     elif fmt == "NPZ":
-        u, y, w0 = _read_npz(path, split)
+        raw = _read_npz(path, names)
     else:
-        u, y, w0, fmt = _read_mat(path, split)
-    if fs is not None and split.period is None:
+        raw, fmt = _read_mat(path, names)
+    source = None
+    found = raw.found() if fs is None and periods is None else None
+    if found is not None:
+        fs, source = found            # the file's own sampling frequency, when nothing overrides it
+    split = _Split(periods, fs, period, trim, source)
+    w0 = raw.w0
+    if fs is not None and w0 is not None:
+        if split.period is None:
+            split.period = 2 * np.pi / w0
+        elif not np.isclose(2 * np.pi / w0, split.period, rtol=1e-9, atol=0):
+            raise FileError(f"the period {split.period:.10g} s disagrees with the file's w0 = {w0:.10g} "
+                            f"rad/s (period {2 * np.pi / w0:.10g} s)")
+    if raw.kind == "column":
+        u_p, y_p = _csv_periods(raw, split)
+    else:
+        u_p = _as_periods(raw.names[0], raw.u, split, "u")
+        y_p = _as_periods(raw.names[1], raw.y, split, "y")
+    if fs is not None and split.period is None and source is None:
         raise FileError("--fs needs the period: give --period (s) or --w0 (rad/s), or store w0 in the file")
-    if u.shape != y.shape:
-        raise FileError(f"u and y differ in shape: u is {_shape(u)} and y is {_shape(y)} (periods x samples)")
-    if u.shape[0] < 2:
+    if u_p.shape != y_p.shape:
+        raise FileError(f"u and y differ in shape: u is {_shape(u_p)} and y is {_shape(y_p)} (periods x samples)")
+    if u_p.shape[0] < 2:
         raise FileError("the record holds only 1 period; the noise model needs at least 2")
     if skip_periods:
-        if u.shape[0] - skip_periods < 2:
-            raise FileError(f"--skip-periods {skip_periods} leaves {u.shape[0] - skip_periods} of "
-                            f"{u.shape[0]} periods; the noise model needs at least 2")
-        u, y = u[skip_periods:], y[skip_periods:]
-    return Measurements(u=u, y=y, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods)
+        if u_p.shape[0] - skip_periods < 2:
+            raise FileError(f"--skip-periods {skip_periods} leaves {u_p.shape[0] - skip_periods} of "
+                            f"{u_p.shape[0]} periods; the noise model needs at least 2")
+        u_p, y_p = u_p[skip_periods:], y_p[skip_periods:]
+    return Measurements(u=u_p, y=y_p, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods,
+                        input=raw.names[0], output=raw.names[1], fs_source=source)
+
+
+def read_options(**kw) -> dict:
+    """The keyword arguments of :func:`read_measurements` (all but the path), checked and
+    converted: FileError naming the first bad one (also for a name that is not one of them)."""
+    known = ("periods", "fs", "dt", "period", "trim", "skip_periods", "u", "y", "time")
+    for k in kw:
+        if k not in known:
+            raise FileError(f"{k!r} is not an argument of lptv.read_measurements (one of {', '.join(known)})")
+    o = dict(dict.fromkeys(known), trim=False, skip_periods=0)
+    o.update(kw)
+    return dict(
+        periods=as_optional(o["periods"], _option, as_int, "--periods", minimum=1),
+        fs=as_optional(o["fs"], _option, as_float, "--fs", minimum=0.0, open_min=True, what="a positive number"),
+        dt=as_optional(o["dt"], _option, as_float, "--dt", minimum=0.0, open_min=True, what="a positive number"),
+        period=as_optional(o["period"], _option, as_float, "--period", minimum=0.0, open_min=True,
+                           what="a positive number"),
+        trim=_option(o["trim"], as_bool, "--trim"), skip_periods=_option(o["skip_periods"], as_int, "--skip-periods"),
+        u=channel_name(o["u"], "u"), y=channel_name(o["y"], "y"), time=channel_name(o["time"], "time"))
 
 
 def _option(x, convert, name, **kw):
@@ -173,13 +249,23 @@ def samples_per_period(fs: float, period: float, what: str = "fs x period") -> i
 class _Split:
     """How a long record becomes periods: by the stated count, by fs and the period, or both."""
 
-    def __init__(self, periods, fs, period, trim):
+    def __init__(self, periods, fs, period, trim, source=None):
         self.periods, self.fs, self.period, self.trim = periods, fs, period, bool(trim)
+        self.source = source
         self.trimmed = 0
+
+    def desc(self):
+        return f"fs {self.fs:g} Hz" + (f" from {self.source}" if self.source else "") + f" x period {self.period:g} s"
 
     def n(self):
         return None if self.fs is None or self.period is None else samples_per_period(
-            self.fs, self.period, f"fs {self.fs:g} Hz x period {self.period:g} s")
+            self.fs, self.period, self.desc())
+
+    def missing(self):
+        """What to give when a vector cannot be split."""
+        if self.fs is not None:
+            return f"the period: --period (s) or --w0 (rad/s) with fs {self.fs:g} Hz from {self.source}, or --periods"
+        return "--periods, the number of periods it holds (or --fs with the period)"
 
     def vector(self, what, v):
         N = self.n()
@@ -188,7 +274,7 @@ class _Split:
                 return None
             return _split_periods(what, v, self.periods)
         P, r = divmod(v.size, N)
-        desc = f"fs {self.fs:g} Hz x period {self.period:g} s"
+        desc = self.desc()
         if P < 1:
             raise FileError(f"{what} has {v.size} samples, less than one period of {N} ({desc})")
         if self.periods is not None and v.size != self.periods * N:
@@ -205,9 +291,8 @@ class _Split:
     def check_shape(self, name, a):
         N = self.n()
         if N is not None and a.shape[1] != N:
-            raise FileError(f"variable '{name}' has {a.shape[1]} samples per period, but fs {self.fs:g} Hz x "
-                            f"period {self.period:g} s gives {N}: the sampling frequency, the period "
-                            "or the record is wrong")
+            raise FileError(f"variable '{name}' has {a.shape[1]} samples per period, but {self.desc()} gives "
+                            f"{N}: the sampling frequency, the period or the record is wrong")
         return a
 
 
@@ -215,7 +300,7 @@ def _shape(a):
     return " x ".join(str(n) for n in a.shape)
 
 
-def _read_csv(path, split):
+def _read_csv(path, names):
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
@@ -224,46 +309,68 @@ def _read_csv(path, split):
     header = next((r for r in rows if any(c.strip() for c in r)), None)
     if header is None:
         raise FileError("the file is empty")
-    names = [c.strip().lower() for c in header]
     if all(_is_number(c) for c in header):
         raise FileError("the first row must be a header naming the columns u and y; it holds numbers")
+    heads = [c.strip() for c in header]
+    shown = "the header has " + ", ".join(repr(c) for c in heads)
     cols = {}
-    for name in ("u", "y"):
-        if names.count(name) > 1:
-            raise FileError(f"column '{name}' appears {names.count(name)} times in the header")
-        if name not in names:
-            found = ", ".join(repr(c.strip()) for c in header)
-            raise FileError(f"column '{name}' is missing (the header has {found})")
-        cols[name] = names.index(name)
-    values = {"u": [], "y": []}
+    for role in ("u", "y"):
+        name = find(names[role], heads, role, "column", shown)
+        if sum(h.lower() == name.lower() for h in heads) > 1:
+            raise FileError(f"column '{name}' appears {sum(h.lower() == name.lower() for h in heads)} times "
+                            "in the header")
+        cols[role] = heads.index(name)
+    chosen = (heads[cols["u"]], heads[cols["y"]])
+    t_name = find(names["time"], heads, "time", "column", shown) if names["time"] else auto_time(heads, chosen)
+    if t_name is not None and t_name not in chosen:
+        cols["time"] = heads.index(t_name)
+    values = {k: [] for k in cols}
     line_of = []
     need = max(cols.values()) + 1
+    t_ok = True
     for row in rows:
         if not any(c.strip() for c in row):
             continue
         if len(row) < need:
             raise FileError(f"line {rows.line_num}: {len(row)} field(s), the header has {len(header)}")
-        for name, i in cols.items():
+        for role, i in cols.items():
             cell = row[i].strip()
             try:
-                values[name].append(float(cell))
+                values[role].append(float(cell))
             except ValueError:
+                if role == "time" and not names["time"]:
+                    t_ok = False     # a column named like a time that holds no numbers: not used
+                    continue
                 what = "is empty" if not cell else f"'{cell}' is not a number"
-                raise FileError(f"line {rows.line_num}: column '{name}' {what}") from None
+                raise FileError(f"line {rows.line_num}: column '{heads[i]}' {what}") from None
         line_of.append(rows.line_num)
     if not line_of:
         raise FileError("no data rows after the header")
-    for name in ("u", "y"):
-        v = np.array(values[name])
+    for role in ("u", "y"):
+        v = np.array(values[role])
         bad = np.flatnonzero(~np.isfinite(v))
         if bad.size:
-            raise FileError(f"line {line_of[bad[0]]}: column '{name}' is NaN or inf")
+            raise FileError(f"line {line_of[bad[0]]}: column '{heads[cols[role]]}' is NaN or inf")
+    def found():
+        if "time" not in cols or not t_ok:
+            return None
+        scale = time_unit(t_name) or 1.0
+        return fs_from_time(values["time"], f"column '{t_name}'", scale, line_of), f"column '{t_name}'"
+
+    return _Raw(np.array(values["u"]), np.array(values["y"]), None, found, "column", chosen, line_of)
+
+
+def _csv_periods(raw, split):
     if split.periods is None and split.n() is None:
+        if split.fs is not None:
+            raise FileError(f"the period is needed to split the {raw.u.size} samples (fs {split.fs:g} Hz from "
+                            f"{split.source}): give --period (s) or --w0 (rad/s), or --periods")
         raise FileError(f"--periods is required for a CSV record (how many periods its "
-                        f"{len(line_of)} samples hold), or --fs with --period")
-    u = split.vector("column 'u'", np.array(values["u"]))
-    _not_transposed("column 'u'", u, np.array(values["u"]), split)
-    return u, split.vector("column 'y'", np.array(values["y"])), None
+                        f"{raw.u.size} samples hold), or --fs with --period, or a time column")
+    what_u, what_y = (f"column '{n}'" for n in raw.names)
+    u = split.vector(what_u, raw.u)
+    _not_transposed(what_u, u, raw.u, split)
+    return u, split.vector(what_y, raw.y)
 
 
 def _not_transposed(what, a, samples, split):
@@ -303,7 +410,7 @@ def _split_periods(what, v, periods):
     return v.reshape(periods, -1)
 
 
-def _as_periods(name, a, split):
+def _as_periods(name, a, split, role):
     """A (P, N) float array from a file variable; vectors are split with --periods or fs."""
     periods = split.periods
     what = f"variable '{name}'"
@@ -320,13 +427,12 @@ def _as_periods(name, a, split):
     if a.ndim < 2 or 1 in a.shape:
         v = split.vector(what, a.ravel())
         if v is None:
-            raise FileError(f"{what} is a vector of {a.size} samples: give --periods, "
-                            "the number of periods it holds (or --fs with the period)")
-        if np.all(np.isfinite(v)) and name == "u":
+            raise FileError(f"{what} is a vector of {a.size} samples: give {split.missing()}")
+        if np.all(np.isfinite(v)) and role == "u":
             _not_transposed(what, v, a.ravel(), split)
         a = v
     else:
-        if np.all(np.isfinite(a)) and name == "u" and (periods is None or a.shape[0] == periods):
+        if np.all(np.isfinite(a)) and role == "u" and (periods is None or a.shape[0] == periods):
             _not_transposed(what, a, None, split)
         if periods is not None and a.shape[0] != periods:
             raise FileError(f"{what} holds {a.shape[0]} periods ({_shape(a)}) but --periods says {periods}")
@@ -347,7 +453,43 @@ def _file_w0(a):
     return float(a.item())
 
 
-def _read_npz(path, periods):
+def _wanted(names, available, kind, shown):
+    """The file's names of u, y and (if any) the time, and the sampling variables present."""
+    u = find(names["u"], available, "u", kind, shown)
+    y = find(names["y"], available, "y", kind, shown)
+    t = find(names["time"], available, "time", kind, shown) if names["time"] else auto_time(available, (u, y))
+    extra = [n for n in FS_NAMES + DT_NAMES + ("w0",) if n in available and n not in (u, y)]
+    return u, y, t, extra
+
+
+def _raw_of(arrays, names, t):
+    """_Raw from the loaded arrays of an NPZ or MAT file."""
+    return _Raw(arrays[names[0]], arrays[names[1]], _file_w0(arrays.get("w0")),
+                lambda: _file_fs(arrays, names, t), "variable", names)
+
+
+def _file_fs(arrays, names, t):
+    """(fs, where from) of stored fs / dt / Ts scalars and a time vector, checked to agree."""
+    found = stored_fs({k: v for k, v in arrays.items() if k not in names})
+    if t is not None:
+        tv = np.asarray(arrays[t])
+        n = np.asarray(arrays[names[0]]).size
+        if tv.dtype.kind not in "fiu" or tv.size != n:
+            if t in names or tv.size == 1:
+                tv = None
+            else:
+                raise FileError(f"variable '{t}' (the time) must hold one number per sample ({n}), "
+                                f"got {tv.size} of dtype {tv.dtype}")
+        if tv is not None:
+            fs_t = fs_from_time(tv, f"variable '{t}'", time_unit(t) or 1.0)
+            if found is not None and not np.isclose(found[0], fs_t, rtol=1e-6, atol=0):
+                raise FileError(f"{found[1]} says fs {found[0]:.10g} Hz but variable '{t}' is sampled at "
+                                f"{fs_t:.10g} Hz")
+            found = found or (fs_t, f"variable '{t}'")
+    return found
+
+
+def _read_npz(path, names):
     try:
         npz = np.load(path, allow_pickle=False)
     except Exception as e:  # zipfile, pickle and OS errors: all mean "not a readable NPZ"
@@ -356,56 +498,49 @@ def _read_npz(path, periods):
         raise FileError("holds a single array, not an NPZ archive with arrays u and y")
     with npz:
         try:
-            arrays = {k: npz[k] for k in ("u", "y", "w0") if k in npz.files}
+            files = list(npz.files)
+            u, y, t, extra = _wanted(names, files, "array", lambda: listing({k: npz[k].shape for k in files}))
+            arrays = {k: npz[k] for k in {u, y, *extra, *([t] if t else [])}}
+        except FileError:
+            raise
         except Exception as e:
             raise FileError(f"cannot read as NPZ: {_one_line(e)}") from None
-    return _u_y_w0(arrays, npz.files, periods, "array")
+    return _raw_of(arrays, (u, y), t)
 
 
-def _read_mat(path, periods):
+def _read_mat(path, names):
     with open(path, "rb") as f:
         head = f.read(128)
     if head.startswith(b"MATLAB 7.3") or head.startswith(b"\x89HDF"):
-        return (*_read_mat73(path, periods), "MAT v7.3")
+        return _read_mat73(path, names), "MAT v7.3"
     import scipy.io
 
     try:
         d = scipy.io.loadmat(path, squeeze_me=False)
     except Exception as e:  # scipy raises a zoo of types for a damaged or foreign file
         raise FileError(f"cannot read as a MATLAB file: {_one_line(e)}") from None
-    names = [k for k in d if not k.startswith("__")]
-    return (*_u_y_w0(d, names, periods, "variable"), "MAT v5")
+    d = {k: v for k, v in d.items() if not k.startswith("__")}
+    u, y, t, _ = _wanted(names, list(d), "variable", listing({k: np.shape(v) for k, v in d.items()}))
+    return _raw_of(d, (u, y), t), "MAT v5"
 
 
-def _read_mat73(path, periods):
+def _read_mat73(path, names):
     try:
         import h5py
     except ImportError:
         raise FileError("reading MATLAB v7.3 files needs h5py (pip install h5py)") from None
     try:
         with h5py.File(path, "r") as f:
-            names = list(f.keys())
-            arrays = {name: _h5_variable(f, name) for name in ("u", "y", "w0") if name in f}
+            avail = list(f.keys())
+            # MATLAB's P x N is N x P in HDF5: the shapes as MATLAB shows them
+            shown = listing({k: getattr(f[k], "shape", None) and f[k].shape[::-1] for k in avail})
+            u, y, t, extra = _wanted(names, avail, "variable", shown)
+            arrays = {name: _h5_variable(f, name) for name in {u, y, *extra, *([t] if t else [])}}
     except FileError:
         raise
     except Exception as e:
         raise FileError(f"cannot read as a MATLAB v7.3 (HDF5) file: {_one_line(e)}") from None
-    return _u_y_w0(arrays, names, periods, "variable")
-
-
-def _u_y_w0(arrays, names, periods, kind):
-    """u and y as (P, N) periods and the optional w0 from what a file holds."""
-    for name in ("u", "y"):
-        if name not in arrays:
-            raise FileError(f"{kind} '{name}' is missing (the file has {', '.join(names) or 'none'})")
-    w0 = _file_w0(arrays.get("w0"))
-    if periods.fs is not None and w0 is not None:
-        if periods.period is None:
-            periods.period = 2 * np.pi / w0
-        elif not np.isclose(2 * np.pi / w0, periods.period, rtol=1e-9, atol=0):
-            raise FileError(f"the period {periods.period:.10g} s disagrees with the file's w0 = {w0:.10g} "
-                            f"rad/s (period {2 * np.pi / w0:.10g} s)")
-    return _as_periods("u", arrays["u"], periods), _as_periods("y", arrays["y"], periods), w0
+    return _raw_of(arrays, (u, y), t)
 
 
 def _h5_variable(f, name):

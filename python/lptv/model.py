@@ -333,7 +333,9 @@ class Model:
 
     def save(self, path) -> None:
         """Write the model as JSON (readable by :meth:`Model.load`)."""
-        with open(as_path(path), "w") as f:
+        from .atomic import atomic_open
+
+        with atomic_open(as_path(path)) as f:     # whole or not at all
             json.dump(self.to_dict(), f, indent=1)
 
     @classmethod

@@ -694,6 +694,28 @@ def python_cases():
         Case("read-npz-u-str", "file", lambda: rm("s.npz", {"u": u().astype(str), "y": y()}), match=r"'u'"),
         Case("read-csv-empty", "file", lambda: rm("e.csv", "", 4), match=r"empty"),
         Case("read-json-ext", "file", lambda: rm("m.json", "{}"), match=r"unknown file type '\.json'"),
+        Case("read_measurements-u-int", "type", lambda: lp().read_measurements(good_npz(), u=3), match=names("u")),
+        Case("read_measurements-u-empty", "value", lambda: lp().read_measurements(good_npz(), u=" "), match=names("u")),
+        Case("read_measurements-u-missing", "file", lambda: lp().read_measurements(good_npz(), u="force"),
+             match=names("u")),
+        Case("read_measurements-y-two", "shape", lambda: lp().read_measurements(good_npz(), y=["y", "u"]),
+             match=names("y")),
+        Case("read_measurements-y-comma", "shape", lambda: lp().read_measurements(good_npz(), y="y,w0"),
+             match=names("y")),
+        Case("read_measurements-time-list", "type", lambda: lp().read_measurements(good_npz(), time=[1.0]),
+             match=names("time")),
+        Case("read_measurements-time-missing", "file", lambda: lp().read_measurements(good_npz(), time="t"),
+             match=names("time")),
+        Case("read-csv-time-not-uniform", "file",
+             lambda: rm("jitter.csv", "t,u,y\n" + "\n".join(f"{k + (k > 5) * 0.5},{a},{b}" for k, (a, b)
+                                                            in enumerate(zip(u().ravel(), y().ravel()))), period=256.0),
+             match=r"'t' is not uniformly sampled: sample 7 \(line 8\)"),
+        Case("read-npz-fs-negative", "file", lambda: rm("fs.npz", {"u": u().ravel(), "y": y().ravel(), "fs": -1.0},
+                                                        period=25.6), match=r"'fs' must be a positive scalar"),
+        Case("read-npz-named-value", "value",
+             lambda: rm("named.npz", {"force": u().ravel(), "disp": y().ravel(), "dt": 0.1}, u="force", y="disp",
+                        period=25.6),
+             check=lambda m: m.u.shape == (4, 256) and np.array_equal(m.u, U()) and m.fs == 10.0),
         Case("read-npz-value", "value", lambda: lp().read_measurements(good_npz()),
              check=lambda m: m.u.shape == (4, 256) and np.array_equal(m.u, U()) and m.w0 == 0.1),
     ]
@@ -733,7 +755,13 @@ def python_cases():
           Case("identify_many-method", "value", lambda: many(method="ml"), match=names("method")),
           Case("identify_many-ka-str", "type", lambda: many(ka="x"), match=names("ka")),
           Case("identify_many-names-length", "shape", lambda: many(names=["a", "b"]), match=names("names")),
-          Case("identify_many-executor", "value", lambda: many(executor="nowhere"), match=names("executor"))]
+          Case("identify_many-executor", "value", lambda: many(executor="nowhere"), match=names("executor")),
+          Case("identify_many-read-str", "type", lambda: many(read="abc"), match=names("read")),
+          Case("identify_many-read-key", "value", lambda: many(read={"channel": "u"}), match=names("read")),
+          Case("identify_many-read-periods", "value", lambda: many(read={"periods": 4}), match=names("read")),
+          Case("identify_many-read-fs", "range", lambda: many(read={"fs": -1.0}), match=names("read")),
+          Case("identify_many-read-u", "type", lambda: many(read={"u": 3}), match=names("read")),
+          Case("identify_many-checkpoint-int", "type", lambda: many(checkpoint=3), match=names("checkpoint"))]
 
     def mc(**kw):
         args = dict(periods=4, runs=1, snr_in_db=40.0, snr_out_db=40.0, executor="serial", progress=False)
@@ -753,7 +781,10 @@ def python_cases():
                                                                         snr_in_db=40, snr_out_db=40),
                match=names("model")),
           Case("montecarlo-excitation-str", "type", lambda: mc(excitation="abc"), match=names("excitation")),
-          Case("montecarlo-methods", "value", lambda: mc(methods="ml"), match=names("methods"))]
+          Case("montecarlo-methods", "value", lambda: mc(methods="ml"), match=names("methods")),
+          Case("montecarlo-checkpoint-int", "type", lambda: mc(checkpoint=3), match=names("checkpoint")),
+          Case("montecarlo-checkpoint-file", "file", lambda: mc(checkpoint=write("a-file", "text")),
+               match=names("checkpoint"))]
 
     # results' methods and plots (matplotlib, the 'plots' extra)
     C += [
@@ -872,6 +903,12 @@ def cli_cases():
     add("identify-discrete-with-ts", ok + ("--discrete", "--ts", "0.1"), "--discrete")
     add("identify-scheduler-not-an-address", ok + ("--scheduler", "not an address"), "(scheduler|executor|dask)")
     add("identify-unknown-option", ok + ("--nope", "1"), "--nope")
+    add("identify-input-missing", ok + ("--input", "force"), "--input")
+    add("identify-output-missing", ok + ("--output", "disp"), "--output")
+    add("identify-output-two", ok + ("--output", "y,u"), "--output")
+    add("identify-time-missing", ok + ("--time", "clock"), "--time")
+    add("identify-resume-one-file", ok + ("--resume",), "--resume")
+    add("identify-resume-nothing", ok + ("--workers", "1", "--out", "{dir}/batch", "--resume"), "--resume")
     add("identify-na-missing", ("identify", "{dir}/good.npz", "--nb", "0"), "--na")
     # lptv select
     add("select-file-junk", ("select", "{dir}/junk.csv", "--periods", "4"), "junk.csv")
@@ -893,6 +930,9 @@ def cli_cases():
     add("select-workers-0", ("select", "{dir}/good.npz", "--workers", "0"), "--workers")
     add("select-scheduler-not-an-address", sel[:-2] + ("--scheduler", "not an address"), "(scheduler|executor|dask)")
     add("select-out-proc", sel + ("--out", "/proc/nope"), "/proc/nope")
+    add("select-input-missing", sel + ("--input", "force"), "--input")
+    add("select-output-two", sel + ("--output", "y,u"), "--output")
+    add("select-time-missing", sel + ("--time", "clock"), "--time")
     # lptv montecarlo
     for opt, vals in (("--runs", ("0", "-1", "abc", "2147483648")), ("--periods", ("1", "abc", "2147483648")),
                       ("--samples", ("0", "-1", "99999999999")), ("--snr-in", ("nan", "abc")),
@@ -916,6 +956,7 @@ def cli_cases():
     add("montecarlo-excited-without-model", mc + ("--excited", "1-10"), "--excited")
     add("montecarlo-scheduler-not-an-address", mc[:5] + ("--scheduler", "not an address"),
         "(scheduler|executor|dask)")
+    add("montecarlo-resume-nothing", mc + ("--resume",), "--resume")
     add("montecarlo-out-proc", ("montecarlo", "--runs", "1", "--workers", "1", "--out", "/proc/nope"), "/proc/nope")
     # lptv demo
     add("demo-out-proc", ("demo", "--quick", "--out", "/proc/nope"), "/proc/nope")

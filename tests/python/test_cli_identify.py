@@ -253,7 +253,7 @@ ERRORS = [
      "unknown file type '.xlsx' (expected .csv, .npz or .mat)"),
     ("no such file", lambda t, s: t / "data.npz", [], "no such file"),
     ("damaged NPZ", lambda t, s: _raw(t, "data.npz", b"not a zip archive"), [], "cannot read as NPZ"),
-    ("NPZ without u", lambda t, s: _npz(t, y=s[1]), [], "array 'u' is missing (the file has y)"),
+    ("NPZ without u", lambda t, s: _npz(t, y=s[1]), [], "array 'u' is missing (the file has y (4 x 64)); name the input and output channels with --input NAME"),
     ("NaN in NPZ", lambda t, s: _npz(t, u=np.where(np.arange(64) == 3, np.nan, s[0]), y=s[1]), [],
      "variable 'u' is NaN or inf at period 1, sample 4 (counting from 1)"),
     ("shapes differ", lambda t, s: _npz(t, u=s[0], y=s[1][:, :-1]), [],
@@ -268,7 +268,7 @@ ERRORS = [
     ("bad w0 in file", lambda t, s: _npz(t, u=s[0], y=s[1], w0=[1.0, 2.0]), [],
      "variable 'w0' must be a positive scalar"),
     ("MAT without y", lambda t, s: (scipy.io.savemat(t / "data.mat", {"u": s[0], "x": s[1]}),
-                                    t / "data.mat")[1], [], "variable 'y' is missing (the file has u, x)"),
+                                    t / "data.mat")[1], [], "variable 'y' is missing (the file has u (4 x 64), x (4 x 64)); name the input"),
     ("damaged MAT", lambda t, s: _raw(t, "data.mat", b"MATLAB 5.0 MAT-file" + b"\x00" * 50), [],
      "cannot read as a MATLAB file"),
     ("MAT v7.3 char", lambda t, s: write_mat73(t / "data.mat", u=s[0], y="text"), [],
@@ -351,7 +351,9 @@ def test_command_exit_status_and_stderr(tmp_path):
     p = subprocess.run([*LPTV, "identify", str(bad), "--na", "1", "--nb", "0", "--w0", "1",
                         "--periods", "2"], capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and p.stdout == ""
-    assert p.stderr == f"lptv identify: error: {bad}: column 'y' is missing (the header has 't', 'u')\n"
+    assert p.stderr == (f"lptv identify: error: {bad}: column 'y' is missing (the header has 't', 'u'); name "
+                        "the input and output channels with --input NAME --output NAME (u=, y= of "
+                        "lptv.read_measurements)\n")
     p = subprocess.run([*LPTV, "identify", str(bad), "--nb", "0"], capture_output=True, text=True,
                        timeout=120)
     assert p.returncode == 2 and "the following arguments are required: --na" in p.stderr

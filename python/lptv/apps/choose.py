@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import read_measurements, select
+from lptv.atomic import atomic_open
 from lptv.apps.fileid import parse_lines, positive
 from lptv.apps.options import bounded_range, in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
@@ -73,6 +74,10 @@ def add_parser(sub):
     g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
     p.add_argument("--ts", type=float, help="sample period: discrete-time models")
     p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
+    p.add_argument("--input", metavar="NAME", help="the input channel (column, array or variable; default u)")
+    p.add_argument("--output", metavar="NAME", help="the output channel (default y; one at a time)")
+    p.add_argument("--time", metavar="NAME",
+                   help="a time column or variable giving fs (default: one named t or time), as for lptv identify")
     p.add_argument("--lines", help="rows of every fit, e.g. 1-243 (default: those of the largest k)")
     p.add_argument("--criterion", default="mdl", choices=["mdl", "aic"], help="ranking criterion (default mdl)")
     p.add_argument("--refine", type=int, default=2, metavar="N",
@@ -100,6 +105,8 @@ def _w0(args, meas):
         w0 = meas.w0
     if positive(args.ts, "--ts") is not None and w0 is None:
         w0 = 2 * np.pi / (meas.u.shape[1] * args.ts)
+    if w0 is None and meas.fs is not None:
+        w0 = 2 * np.pi * meas.fs / meas.u.shape[1]     # the file's own fs: the period is N / fs
     if w0 is None:
         raise FileError("the period is unknown: give --w0 (rad/s) or --period (s)")
     return float(w0)
@@ -119,7 +126,10 @@ def run(args) -> int:
         except OSError as e:
             raise FileError(f"{e.filename or args.out}: {e.strerror or e}") from None
         executor, workers = executor_of(args)
-        meas = read_measurements(src, args.periods)
+        period = positive(args.period, "--period")
+        if period is None and positive(args.w0, "--w0") is not None:
+            period = 2 * np.pi / args.w0
+        meas = read_measurements(src, args.periods, period=period, u=args.input, y=args.output, time=args.time)
         w0 = _w0(args, meas)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")      # the result says the same in its warnings
@@ -136,7 +146,7 @@ def run(args) -> int:
     print(sel.summary())
     try:
         out.mkdir(parents=True, exist_ok=True)
-        with open(out / "selection.csv", "w", newline="") as f:
+        with atomic_open(out / "selection.csv", "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(sel.rows[0]))
             w.writeheader()
             w.writerows(sel.rows)

@@ -6,12 +6,15 @@ model by :mod:`lptv.apps.jointid`.)
 
 The file holds P >= 2 steady-state periods of the input u and the output y:
 
-- CSV: a header row naming the columns ``u`` and ``y`` (other columns are ignored), one sample
-  per row, the periods one after another; ``--periods P`` says how many the record holds.
-- NPZ: arrays ``u`` and ``y`` of shape (P, N), optionally a scalar ``w0`` (rad/s).
-- MATLAB ``.mat`` (v4/v5/v7 via scipy, v7.3 via h5py): variables ``u`` and ``y`` of size P x N,
-  optionally a scalar ``w0``. In NPZ and MAT files, vectors are accepted with ``--periods``.
+- CSV: a header row naming the columns (``u`` and ``y``, or ``--input NAME --output NAME``;
+  other columns are ignored), one sample per row, the periods one after another.
+- NPZ: arrays (``u`` and ``y`` or as named) of shape (P, N) or long vectors, optionally a scalar
+  ``w0`` (rad/s).
+- MATLAB ``.mat`` (v4/v5/v7 via scipy, v7.3 via h5py): variables as in NPZ.
 
+A long record is split by ``--periods`` or by the sampling frequency and the period: fs is
+``--fs`` / ``--dt``, else the file's time column or variable (``t``, ``time``, ``--time NAME``;
+checked uniform) or its stored ``fs`` / ``dt`` / ``Ts``, said in the first line of the output.
 The period comes from ``--w0`` (rad/s), ``--period`` (s), the file's ``w0`` or, in discrete time,
 from ``--ts`` and the samples per period. The command writes ``model.json`` (readable by
 :meth:`lptv.Model.load`), ``report.html`` with the validation figures, and ``summary.json``, and
@@ -128,9 +131,13 @@ def fundamental(args, meas):
 
 _HELP = """\
 Identify an LPTV model from P >= 2 measured steady-state periods of input u and output y.
-  .csv  header row naming columns u and y, periods one after another (needs --periods)
-  .npz  arrays u, y of shape (P, N); optional scalar w0 (rad/s)
-  .mat  MATLAB v5 or v7.3: variables u, y of size P x N; optional scalar w0
+  .csv  header row naming the columns (u and y, or --input NAME --output NAME), periods one
+        after another; a time column (t, time, time [s], or --time NAME) gives fs
+  .npz  arrays u, y (or as named) of shape (P, N) or one long vector each; optional scalars w0
+        (rad/s) and fs (Hz) or dt / Ts (s), or a time vector t
+  .mat  MATLAB v5 or v7.3: variables as in .npz
+A long record is split into periods by --periods, or by fs (--fs / --dt, else the file's time
+or stored fs) and the period (--period / --w0); the first line of the output says which fs.
 Writes model.json, report.html and summary.json, and prints the validation verdict.
 Several files (or --workers / --scheduler) make a batch: one row per file in results.csv,
 each model in models/, the fits on local processes or a Dask cluster. With --joint the files
@@ -144,6 +151,7 @@ def add_parser(sub):
         epilog="examples:\n"
                "  lptv identify record.csv --fs 100 --period 10 --na 2 --nb 0 --method sml\n"
                "  lptv identify record.csv --fs 100 --period 10 --trim --skip-periods 1 --na 2 --nb 0\n"
+               "  lptv identify rig.csv --input force --output displacement --period 10 --na 2 --nb 0 --ka 1\n"
                "  lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
                "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2\n"
                "  lptv identify low.npz high.npz --joint --na 2 --nb 1 --method sml")
@@ -165,6 +173,13 @@ def add_parser(sub):
                    help="identify a discrete-time model (in the shift z) with the sample period 1 / fs")
     p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "
                    "to state how the record was sampled for a continuous-time model use --fs or --dt")
+    p.add_argument("--input", metavar="NAME",
+                   help="the input channel: a CSV column, NPZ array or MAT variable (default u)")
+    p.add_argument("--output", metavar="NAME",
+                   help="the output channel (default y); one at a time, MIMO models are not supported yet")
+    p.add_argument("--time", metavar="NAME",
+                   help="a time column or variable (s) giving fs, checked uniform (default: one named t or "
+                        "time); without --fs, --dt and --periods the file's time or stored fs / dt / Ts is used")
     p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
     p.add_argument("--trim", action="store_true",
                    help="with --fs: drop the first samples of a long record to keep whole periods")
@@ -191,6 +206,9 @@ def add_parser(sub):
                    help="batch: fit the files on N local processes (default: all cores; 1: serially)")
     b.add_argument("--scheduler", metavar="ADDRESS",
                    help="batch: fit the files on a Dask cluster, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--resume", action="store_true",
+                   help="batch: complete an interrupted batch from the fits kept in --out/parts/ (a rerun with "
+                        "the same files, options and --out does the same)")
     return p
 
 
@@ -217,6 +235,10 @@ def run(args) -> int:
                                           or args.scheduler is not None):
         print("lptv identify: error: --covariance bootstrap takes one record at a time (not several files, "
               "--joint, --workers or --scheduler)", file=sys.stderr)
+        return 2
+    if args.resume and (args.joint or (len(args.files) == 1 and args.workers is None and args.scheduler is None)):
+        print("lptv identify: error: --resume applies to a batch of files (several files, --workers or "
+              "--scheduler), not to one record or --joint", file=sys.stderr)
         return 2
     if args.joint:
         from lptv.apps import jointid
@@ -264,7 +286,7 @@ def run(args) -> int:
     P, N = meas.u.shape
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
     print(f"lptv identify: {src} ({meas.format}, {P} periods of {N} samples, w0 = {w0:.6g} rad/s"
-          + (f", fs = {meas.fs:g} Hz" if meas.fs else "")
+          + describe_record(meas)
           + (f", discrete-time model with ts = {args.ts:g} s" if args.ts else ", continuous-time model")
           + f") -> {out}/")
     if meas.trimmed or meas.skipped:
@@ -306,7 +328,8 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "fraction_above_0db": res.fraction_above_0db, "fraction_expected": res.fraction_expected,
         "fraction_band": list(res.fraction_band), "residue_ok": res.residue_ok,
         "prediction_error_vs_noise_db": _prediction_gap_db(res, Y_pred),
-        "fs": meas.fs, "trimmed_samples": meas.trimmed, "skipped_periods": meas.skipped,
+        "fs": meas.fs, "fs_source": meas.fs_source, "input": meas.input, "output": meas.output,
+        "trimmed_samples": meas.trimmed, "skipped_periods": meas.skipped,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "undetermined": res.undetermined,
         "n_verdict_lines": int(res.verdict_lines.size), "verdict_fraction_above_0db": res.verdict_fraction,
@@ -426,16 +449,29 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
     return rep
 
 
+def read_options(args) -> dict:
+    """The keyword arguments of lptv.read_measurements the options give (--periods, --fs / --dt,
+    --period or --w0, --trim, --skip-periods, --input, --output, --time)."""
+    period = positive(args.period, "--period")
+    if period is None and positive(args.w0, "--w0") is not None:
+        period = 2 * np.pi / args.w0
+    return dict(periods=args.periods, fs=args.fs, dt=args.dt, period=period, trim=args.trim,
+                skip_periods=args.skip_periods, u=args.input, y=args.output, time=args.time)
+
+
 def read_record(src, args):
-    """The periods of one file as the options say (--periods, --fs / --dt with --period or --w0,
-    --trim, --skip-periods)."""
-    period = None
-    if args.fs is not None or args.dt is not None:
-        period = positive(args.period, "--period")
-        if period is None and positive(args.w0, "--w0") is not None:
-            period = 2 * np.pi / args.w0
-    return read_measurements(src, args.periods, fs=args.fs, dt=args.dt, period=period,
-                             trim=args.trim, skip_periods=args.skip_periods)
+    """The periods of one file as the options say (:func:`read_options`)."""
+    return read_measurements(src, **read_options(args))
+
+
+def describe_record(meas) -> str:
+    """', fs = 50 Hz from column 'time', input 'force', output 'disp'' (what the first line says)."""
+    text = ""
+    if meas.fs:
+        text += f", fs = {meas.fs:g} Hz" + (f" from {meas.fs_source}" if meas.fs_source else "")
+    if (meas.input, meas.output) != ("u", "y"):
+        text += f", input '{meas.input}', output '{meas.output}'"
+    return text
 
 
 def _json_residue_tests(res):

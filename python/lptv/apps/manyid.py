@@ -14,14 +14,17 @@ Example::
 """
 from __future__ import annotations
 
+import signal
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from lptv import identify_many
-from lptv.apps.fileid import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive
-from lptv.apps.options import in_option_terms, integer, output_folder
+from lptv.apps.fileid import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive, read_options
+from lptv.apps.options import Interrupted, in_option_terms, integer, interruptible, output_folder
+from lptv.batch.executors import LOST
+from lptv.batch.parts import CheckpointError, clear, stored_items
 from lptv.apps.report import write_json
 from lptv.measurements import FileError
 
@@ -33,8 +36,16 @@ def _error(problem) -> int:
 
 
 def executor_of(args):
-    """(executor, workers) from --workers / --scheduler."""
+    """(executor, workers) from --workers / --scheduler. With a scheduler, the Dask client's own
+    log (a traceback per failed reconnection when the scheduler is lost) is silenced: the command
+    says what was lost and how to resume in one line."""
     if args.scheduler is not None:
+        import contextlib
+        import logging
+
+        with contextlib.suppress(ImportError):
+            import distributed  # noqa: F401 - its import configures its loggers: set the level after
+        logging.getLogger("distributed.client").setLevel(logging.CRITICAL)
         return args.scheduler, None
     if args.workers is not None:
         if args.workers < 1:
@@ -51,6 +62,13 @@ def _stems(files):
         seen[stem] = seen.get(stem, 0) + 1
         out.append(stem if seen[stem] == 1 else f"{stem}-{seen[stem]}")
     return out
+
+
+def _read(args) -> dict:
+    """The options that say how to read each file (channels, fs, trim ...), for identify_many."""
+    o = read_options(args)
+    return {k: v for k, v in o.items()
+            if k != "periods" and v is not None and v is not False and not (k == "skip_periods" and v == 0)}
 
 
 def run(args) -> int:
@@ -71,14 +89,45 @@ def run(args) -> int:
             integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         executor, workers = executor_of(args)
         output_folder(args.out)
-        result = identify_many(args.files, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts,
-                               lines=lines, method=args.method, known=known, tol=args.tol,
-                               max_iter=args.max_iter, periods=args.periods, executor=executor,
-                               workers=workers)
+        out = Path(args.out) if args.out else Path("lptv-identify")
+        parts = out / "parts"
+        held = stored_items(parts)
+        if args.resume and held is None:
+            raise FileError(f"--resume: {parts} holds no batch to resume")
+        batch = dict(na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts, lines=lines, method=args.method,
+                     known=known, tol=args.tol, max_iter=args.max_iter, periods=args.periods, read=_read(args),
+                     executor=executor, workers=workers, checkpoint=parts)
     except (FileError, ValueError, ImportError, OSError) as e:
         return _error(e)
+    with interruptible():
+        try:
+            if held:
+                print(f"resuming: {held} of {len(args.files)} files are fitted in {parts}/", flush=True)
+            try:
+                result = identify_many(args.files, **batch)
+            except CheckpointError:
+                if args.resume:
+                    raise
+                print(f"{parts}/ held the fits of another batch: replaced", flush=True)
+                clear(parts)
+                result = identify_many(args.files, **batch)
+            return _write(args, out, parts, result)
+        except (FileError, ValueError, ImportError, OSError) as e:
+            return _error(e)
+        except Interrupted as e:
+            print(f"lptv identify: interrupted by {signal.Signals(e.signum).name}: {stored_items(parts) or 0} of "
+                  f"{len(args.files)} files are fitted and kept in {parts}/; rerun the same command with --resume "
+                  "to complete the batch", file=sys.stderr)
+            return e.status
 
-    out = Path(args.out) if args.out else Path("lptv-identify")
+
+def _write(args, out, parts, result) -> int:
+    lost = [r["record"] for r in result.rows if not r["ok"] and str(r["error"]).startswith(LOST)]
+    if lost:
+        print(f"lptv identify: error: {len(lost)} of {len(result.rows)} files were lost ({lost[0]}: "
+              f"{next(r['error'] for r in result.rows if r['record'] == lost[0])}); the others are kept in "
+              f"{parts}/: rerun the same command with --resume to complete the batch", file=sys.stderr)
+        return 1
     print(f"lptv identify: {len(args.files)} files, {args.method}, {result.executor}, "
           f"{result.elapsed:.1f} s -> {out}/")
     for row in result.rows:

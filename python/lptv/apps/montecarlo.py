@@ -17,6 +17,7 @@ Example::
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from pathlib import Path
 
@@ -24,9 +25,11 @@ import numpy as np
 
 from lptv import METHODS, Model, montecarlo, multisine
 from lptv.apps.fileid import parse_lines
-from lptv.apps.options import in_option_terms, integer, output_folder
+from lptv.apps.options import Interrupted, in_option_terms, integer, interruptible, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import Report, write_json
+from lptv.batch.executors import LOST
+from lptv.batch.parts import CheckpointError, clear, stored_items
 from lptv.examples import (PAPER_ID_LINES, PAPER_NOISE, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB,
                            paper_model, paper_multisine)
 from lptv.measurements import FileError
@@ -72,13 +75,17 @@ def add_parser(sub):
     p.add_argument("--chunk-size", type=int, metavar="C", help="realisations per task (default: automatic)")
     p.add_argument("--format", default="csv", choices=["csv", "parquet"], help="of the tables (default csv)")
     p.add_argument("--out", default="lptv-montecarlo", help="output folder (default lptv-montecarlo/)")
+    p.add_argument("--resume", action="store_true",
+                   help="complete an interrupted study: the chunks finished so far are in --out/parts/ (a rerun "
+                        "with the same options and --out does the same); the tables are those of an "
+                        "uninterrupted run, bit for bit")
     return p
 
 
 OPTION_NAMES = {"runs": "--runs", "periods": "--periods", "snr_in_db": "--snr-in",
                 "snr_out_db": "--snr-out", "pole_in": "--pole-in", "pole_out": "--pole-out",
                 "correlation": "--correlation", "seed": "--seed", "chunk_size": "--chunk-size",
-                "lines": "--lines", "n_samples": "--samples", "workers": "--workers"}
+                "lines": "--lines", "n_samples": "--samples", "workers": "--workers", "checkpoint": "--out"}
 
 
 def _error(problem) -> int:
@@ -135,18 +142,57 @@ def run(args) -> int:
             require("pyarrow", "--format parquet")
         model, ms, lines, what = _design(args)
         executor, workers = executor_of(args)
-        print(f"lptv montecarlo: {what}; {args.runs} runs x {args.method}, P = {args.periods}, "
-              f"SNR {args.snr_in:g} / {args.snr_out:g} dB -> {args.out}/", flush=True)
-        mc = montecarlo(model, ms, periods=args.periods, runs=args.runs, methods=args.method,
-                        snr_in_db=args.snr_in, snr_out_db=args.snr_out, pole_in=args.pole_in,
-                        pole_out=args.pole_out, correlation=args.correlation, lines=lines,
-                        seed=args.seed, executor=executor, workers=workers, chunk_size=args.chunk_size)
-        paths = mc.save(args.out, format=args.format)
-        overview = mc.overview()
+        parts = Path(args.out) / "parts"
+        held = stored_items(parts)
+        if args.resume and held is None:
+            raise FileError(f"--resume: {parts} holds no study to resume")
     except (FileError, ValueError, ImportError) as e:
         return _error(e)
     except OSError as e:
         return _error(f"{e.filename or args.out}: {e.strerror or e}")
+    with interruptible():
+        try:
+            return _study(args, model, ms, lines, what, executor, workers, parts, held)
+        except Interrupted as e:
+            done = stored_items(parts) or 0
+            print(f"lptv montecarlo: interrupted by {signal.Signals(e.signum).name}: {done} of {args.runs} "
+                  f"realisations are kept in {parts}/; rerun the same command with --resume to complete the "
+                  "study", file=sys.stderr)
+            return e.status
+
+
+def _study(args, model, ms, lines, what, executor, workers, parts, held) -> int:
+    print(f"lptv montecarlo: {what}; {args.runs} runs x {args.method}, P = {args.periods}, "
+          f"SNR {args.snr_in:g} / {args.snr_out:g} dB -> {args.out}/", flush=True)
+    try:
+        if held:
+            print(f"resuming: {held} of {args.runs} realisations are done in {parts}/", flush=True)
+        study = dict(periods=args.periods, runs=args.runs, methods=args.method, snr_in_db=args.snr_in,
+                     snr_out_db=args.snr_out, pole_in=args.pole_in, pole_out=args.pole_out,
+                     correlation=args.correlation, lines=lines, seed=args.seed, executor=executor,
+                     workers=workers, chunk_size=args.chunk_size, checkpoint=parts)
+        try:
+            mc = montecarlo(model, ms, **study)
+        except CheckpointError:
+            if args.resume:
+                raise
+            # a new study in the same --out replaces the old one's parts, as it replaces its tables
+            print(f"{parts}/ held the parts of another study: replaced", flush=True)
+            clear(parts)
+            mc = montecarlo(model, ms, **study)
+        lost = {f["run"]: f["error"] for f in mc.fits if f["error"].startswith(LOST)}
+        if lost:
+            first = next(iter(lost.values()))
+            print(f"lptv montecarlo: error: {len(lost)} of {args.runs} realisations were lost ({first}); "
+                  f"the {args.runs - len(lost)} finished are kept in {parts}/: rerun the same command with "
+                  "--resume to complete the study", file=sys.stderr)
+            return 1
+        paths = mc.save(args.out, format=args.format)
+        overview = mc.overview()
+    except (FileError, ValueError, ImportError) as e:
+        return _error(e)
+    except OSError as e:   # a file that cannot be written, or a scheduler that cannot be reached
+        return _error(f"{e.filename}: {e.strerror or e}" if e.filename else e)
     print(mc.report())
     out = Path(args.out)
     write_json(out / "summary.json", {

@@ -10,10 +10,13 @@ that cannot be written is reported at once.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import errno
 import os
 import re
+import signal
 import tempfile
+import threading
 from pathlib import Path
 
 from lptv.measurements import FileError
@@ -82,3 +85,41 @@ def in_option_terms(message: str, names: dict) -> str:
         if new != message:
             return new
     return message
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT (Ctrl-C) or SIGTERM during a long command; ``status`` is the exit status a shell
+    gives a process killed by that signal (128 + its number: 130, 143)."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+        self.status = 128 + signum
+
+
+@contextlib.contextmanager
+def interruptible():
+    """Turns the first SIGINT or SIGTERM in the block into :class:`Interrupted` (the command then
+    stops cleanly: what is finished stays on disk) and ignores the next ones (a second Ctrl-C, or
+    the same signal sent to the process group), so that the command's last line and exit status
+    are its own. The previous handlers are restored after a block that was not interrupted; an
+    interrupted command is ending, and keeps ignoring them until it exits."""
+    signals = (signal.SIGINT, signal.SIGTERM)
+    interrupted = []
+
+    def handler(signum, frame):
+        for s in signals:
+            signal.signal(s, signal.SIG_IGN)
+        interrupted.append(signum)
+        raise Interrupted(signum)
+
+    if threading.current_thread() is not threading.main_thread():
+        yield   # signals reach the main thread only
+        return
+    old = {s: signal.signal(s, handler) for s in signals}
+    try:
+        yield
+    finally:
+        if not interrupted:
+            for s, h in old.items():
+                signal.signal(s, h)

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lptv.atomic import atomic_open
+
 
 class Report:
     """Collects the pieces of a report and writes ``report.html`` plus the figures as PNG.
@@ -70,7 +72,8 @@ class Report:
         out = Path(os.fspath(out_dir))
         out.mkdir(parents=True, exist_ok=True)
         for name, data in self._figures:
-            (out / name).write_bytes(data)
+            with atomic_open(out / name, "wb") as f:
+                f.write(data)
         style = ("body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}"
                  "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:.2em .6em;"
                  "text-align:right}td:first-child{text-align:left}th{background:#eee}figure{margin:1.5em 0}img{max-width:100%}"
@@ -79,7 +82,8 @@ class Report:
                 f"</title><style>{style}</style></head><body><h1>{html.escape(self.title)}</h1>"
                 + "\n".join(self._parts) + "</body></html>")
         path = out / "report.html"
-        path.write_text(page, encoding="utf-8")
+        with atomic_open(path, encoding="utf-8") as f:
+            f.write(page)
         return path
 
 
@@ -92,5 +96,5 @@ def write_json(path, obj):
             return o.tolist()
         raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
-    with open(os.fspath(path), "w") as f:
+    with atomic_open(os.fspath(path)) as f:
         json.dump(obj, f, indent=1, default=conv)

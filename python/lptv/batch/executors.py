@@ -186,7 +186,7 @@ def _check_executor(executor, workers):
 
 def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="processes",
               workers: Optional[int] = None, chunk_size: Optional[int] = None, progress=None,
-              desc: str = "lptv", unit: str = "item", weight: int = 1) -> List[Any]:
+              desc: str = "lptv", unit: str = "item", weight: int = 1, checkpoint=None) -> List[Any]:
     """``[fn(item, shared) for item in items]`` on an executor, in chunks, with progress.
 
     Parameters
@@ -209,6 +209,11 @@ def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="pr
         Progress bar with an ETA: None shows it when stderr is a terminal.
     desc, unit, weight :
         Label and unit of the bar; each item counts ``weight`` units (e.g. the fits it makes).
+    checkpoint : str or Path, optional
+        A folder where each finished chunk is written as it completes (:mod:`lptv.batch.parts`);
+        the items it already holds (of the same study) are read back instead of run again, so
+        that a study interrupted (Ctrl-C, a kill, a lost cluster) resumes where it stopped with
+        the same results, bit for bit. A folder holding another study is refused (ValueError).
 
     Returns
     -------
@@ -229,21 +234,44 @@ def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="pr
     if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(chunk_size, int)
                                    or chunk_size < 1):
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    out = [None] * len(items)
+    store, todo = None, list(range(len(items)))
+    if checkpoint is not None:
+        from .parts import Checkpoint
+
+        store = Checkpoint(checkpoint, fn, items, shared, desc)
+        done = store.load()
+        for i, r in done.items():
+            out[i] = r
+        todo = [i for i in todo if i not in done]
+
+    def finished(indices, results):
+        for i, r in zip(indices, results):
+            out[i] = r
+        if store is not None:
+            store.write(indices, results)
+
     bar = _Progress(len(items) * weight, progress, desc, unit)
+    bar.update((len(items) - len(todo)) * weight)
     try:
         if executor == "serial":
-            out = []
             restore = one_blas_thread()
             try:
-                for item in items:
-                    out.append(_call(fn, item, shared))
-                    bar.update(weight)
+                size = chunk_size or default_chunk_size(len(todo), 1)
+                for c in _chunks(len(todo), size):
+                    idx = [todo[k] for k in c]
+                    results = []
+                    for i in idx:
+                        results.append(_call(fn, items[i], shared))
+                        bar.update(weight)
+                    finished(idx, results)
             finally:
                 restore()
-            return out
-        if executor == "processes" or isinstance(executor, cf.Executor):
-            return _run_futures(fn, items, shared, executor, workers, chunk_size, bar, weight)
-        return _run_dask(fn, items, shared, executor, chunk_size, bar, weight)
+        elif executor == "processes" or isinstance(executor, cf.Executor):
+            _run_futures(fn, items, todo, shared, executor, workers, chunk_size, bar, weight, finished, out)
+        else:
+            _run_dask(fn, items, todo, shared, executor, chunk_size, bar, weight, finished, out)
+        return out
     finally:
         bar.close()
 
@@ -252,33 +280,47 @@ def _chunks(n, size):
     return [range(i, min(n, i + size)) for i in range(0, n, size)]
 
 
+LOST = "task lost: "
+"""The start of the message of an item whose chunk was lost (a dead worker, a lost cluster)."""
+
+
 def _lost(chunk, e, out):
-    f = Failure(f"task lost: {_one_line(e)}", "".join(traceback.format_exception(type(e), e, e.__traceback__)))
+    f = Failure(f"{LOST}{_one_line(e)}", "".join(traceback.format_exception(type(e), e, e.__traceback__)))
     for i in chunk:
         out[i] = f
 
 
-def _run_futures(fn, items, shared, executor, workers, chunk_size, bar, weight):
+def _ignore_interrupts():
+    """In a pool's worker: Ctrl-C (sent to the whole process group) and SIGTERM are the parent's
+    to handle; the worker finishes its chunk and is shut down by the parent."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+
+
+def _run_futures(fn, items, todo, shared, executor, workers, chunk_size, bar, weight, finished, out):
     own = executor == "processes"
     if own:
         workers = workers or available_cores()
     else:
         workers = getattr(executor, "_max_workers", None) or available_cores()
-    size = chunk_size or default_chunk_size(len(items), workers)
-    chunks = _chunks(len(items), size)
-    out = [None] * len(items)
+    size = chunk_size or default_chunk_size(len(todo), workers)
+    chunks = [[todo[k] for k in c] for c in _chunks(len(todo), size)]
     if not chunks:
-        return out
-    pool = cf.ProcessPoolExecutor(max_workers=min(workers, len(chunks))) if own else executor
+        return
+    pool = (cf.ProcessPoolExecutor(max_workers=min(workers, len(chunks)), initializer=_ignore_interrupts)
+            if own else executor)
     try:
         futures = {pool.submit(run_chunk, [items[i] for i in c], fn, shared): c for c in chunks}
         for fut in cf.as_completed(futures):
             c = futures[fut]
             try:
-                for i, r in zip(c, fut.result()):
-                    out[i] = r
+                results = fut.result()
             except Exception as e:  # noqa: BLE001 - a dead worker: its items fail, not the batch
                 _lost(c, e, out)
+            else:
+                finished(c, results)
             bar.update(weight * len(c))
     except BaseException:
         if own:
@@ -286,18 +328,16 @@ def _run_futures(fn, items, shared, executor, workers, chunk_size, bar, weight):
         raise
     if own:
         pool.shutdown(wait=True)
-    return out
 
 
-def _run_dask(fn, items, shared, executor, chunk_size, bar, weight):
+def _run_dask(fn, items, todo, shared, executor, chunk_size, bar, weight, finished, out):
     distributed = require("distributed", "a Dask executor")
     client = distributed.Client(executor, set_as_default=False) if isinstance(executor, str) else executor
     try:
-        size = chunk_size or default_chunk_size(len(items), _dask_threads(client))
-        chunks = _chunks(len(items), size)
-        out = [None] * len(items)
+        size = chunk_size or default_chunk_size(len(todo), _dask_threads(client))
+        chunks = [[todo[k] for k in c] for c in _chunks(len(todo), size)]
         if not chunks:
-            return out
+            return
         # one copy of the design per worker instead of one per task; in a list, so that it gets a
         # key of its own (a dict would be scattered under its own keys, shared by every run)
         [shared_f] = client.scatter([shared], broadcast=True, hash=False)
@@ -309,16 +349,16 @@ def _run_dask(fn, items, shared, executor, chunk_size, bar, weight):
             for fut in distributed.as_completed(futures, loop=client.loop):
                 c = where[fut.key]
                 try:
-                    for i, r in zip(c, fut.result()):
-                        out[i] = r
+                    results = fut.result()
                 except Exception as e:  # noqa: BLE001 - a lost worker or task: its items fail
                     _lost(c, e, out)
+                else:
+                    finished(c, results)
                 bar.update(weight * len(c))
                 fut.release()
         except BaseException:
             client.cancel(futures)
             raise
-        return out
     finally:
         if isinstance(executor, str):
             client.close()

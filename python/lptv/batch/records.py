@@ -13,7 +13,8 @@ import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_positive_float
 from ..identify import METHODS, _counts, _known_list, _rows, identify
-from ..measurements import Measurements, read_measurements
+from ..atomic import atomic_open, atomic_path
+from ..measurements import Measurements, read_measurements, read_options
 from ..model import Model
 from .executors import Failure, describe_executor, require, run_tasks
 
@@ -23,11 +24,17 @@ COLUMNS = ("record", "ok", "error", "format", "periods", "samples", "w0", "metho
            "n_free_parameters", "warnings")
 
 
-def _arrays(record, periods):
-    """u, y, w0 and the format of one record (a file is read here, i.e. on the worker)."""
+def _arrays(record, read):
+    """u, y, w0 and the format of one record (a file is read here, i.e. on the worker); a file
+    without w0 but with a sampling frequency (given or its own) has the period N / fs."""
     if isinstance(record, (str, os.PathLike)):
-        m = read_measurements(record, periods)
-        return m.u, m.y, m.w0, m.format
+        m = read_measurements(record, **read)
+        w0 = m.w0
+        if w0 is None and read.get("period") is not None:
+            w0 = 2 * np.pi / read["period"]
+        elif w0 is None and m.fs is not None:
+            w0 = 2 * np.pi * m.fs / m.u.shape[1]
+        return m.u, m.y, w0, m.format
     if isinstance(record, Measurements):
         return record.u, record.y, record.w0, record.format
     if isinstance(record, Mapping):
@@ -59,7 +66,7 @@ def _w0(w0, w0_record, ts, n_samples):
 def identify_record(item, settings) -> dict:
     """One record (the task :func:`identify_many` sends out): read, identify, return plain data."""
     name, record = item
-    u, y, w0_record, fmt = _arrays(record, settings["periods"])
+    u, y, w0_record, fmt = _arrays(record, dict(settings.get("read") or {}, periods=settings["periods"]))
     u, y = np.asarray(u), np.asarray(y)
     n_samples = u.shape[-1] if u.ndim else 0
     w0 = _w0(settings["w0"], w0_record, settings["ts"], n_samples)
@@ -116,9 +123,10 @@ class BatchResult:
         path = Path(as_path(path))
         if path.suffix.lower() == ".parquet":
             require("pyarrow", "writing Parquet")
-            self.table().to_parquet(path, index=False)
+            with atomic_path(path) as tmp:
+                self.table().to_parquet(tmp, index=False)
         elif path.suffix.lower() == ".csv":
-            with open(path, "w", newline="") as f:
+            with atomic_open(path, "w", newline="") as f:
                 w = csv.DictWriter(f, fieldnames=self.columns, restval="")
                 w.writeheader()
                 for r in self.rows:
@@ -127,6 +135,22 @@ class BatchResult:
         else:
             raise ValueError(f"path must end in .csv or .parquet, got {path.name!r}")
         return path
+
+
+def _read(read):
+    """identify_many's ``read``: checked here, before any record is read."""
+    if read is None:
+        return {}
+    if not isinstance(read, Mapping):
+        raise ValueError(f"read must be a dict of keyword arguments of lptv.read_measurements, got "
+                         f"{type(read).__name__}")
+    if "periods" in read:
+        raise ValueError("read must not hold periods: give it as identify_many's own argument periods=")
+    try:
+        checked = read_options(**read)
+    except ValueError as e:
+        raise ValueError(f"read: {e}") from None
+    return {k: v for k, v in checked.items() if k in read}
 
 
 def _slim(record):
@@ -162,9 +186,11 @@ def _names(records, names):
 def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] = None,
                   ts: Optional[float] = None, lines=None, method: str = "wgtls",
                   known: Optional[Mapping] = None, tol: float = 1e-10, max_iter: int = 50,
-                  periods: Optional[int] = None, names: Optional[Sequence[str]] = None,
+                  periods: Optional[int] = None, read: Optional[Mapping] = None,
+                  names: Optional[Sequence[str]] = None,
                   executor="processes", workers: Optional[int] = None,
-                  chunk_size: Optional[int] = None, progress: Optional[bool] = None) -> BatchResult:
+                  chunk_size: Optional[int] = None, progress: Optional[bool] = None,
+                  checkpoint=None) -> BatchResult:
     """:func:`lptv.identify` on many records, one row of results per record.
 
     A record that cannot be read or fitted (a bad file, NaN in the data, a singular system)
@@ -185,10 +211,17 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
         In discrete time it may come from ``ts`` and each record's samples per period.
     periods : int, optional
         Periods in a CSV record (or a vector in NPZ/MAT).
+    read : dict, optional
+        Other keyword arguments of :func:`lptv.read_measurements` for the files, e.g.
+        ``dict(u="force", y="disp", period=10.0)`` (channels by name, fs, trim ...).
     names : sequence of str, optional
         Row labels (default: the file paths, or 'record i').
     executor, workers, chunk_size, progress :
         Where and how the fits run (:func:`lptv.batch.run_tasks`).
+    checkpoint : str or Path, optional
+        A folder where every finished chunk of records is written as it completes; a rerun
+        with the same records, options and folder fits only the records it lacks
+        (:mod:`lptv.batch.parts`).
 
     Returns
     -------
@@ -220,14 +253,17 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     w0 = None if w0 is None else as_positive_float(w0, "w0")
     ts = None if ts is None else as_positive_float(ts, "ts")
     periods = None if periods is None else as_int(periods, "periods", minimum=1)
+    read = _read(read)
+    if checkpoint is not None:
+        checkpoint = as_path(checkpoint, "checkpoint")
     names, recs = _names(records, names)
-    settings = dict(w0=w0, ts=ts, periods=periods,
+    settings = dict(w0=w0, ts=ts, periods=periods, read=read,
                     fit=dict(na=na, nb=nb, ka=ka_l, kb=kb_l, lines=lines, method=method, known=known,
                              tol=float(tol), max_iter=max_iter))
     t0 = time.perf_counter()
     out = run_tasks(identify_record, [(n, _slim(r)) for n, r in zip(names, recs)], settings, executor=executor,
                     workers=workers, chunk_size=chunk_size, progress=progress, desc="identify",
-                    unit="record")
+                    unit="record", checkpoint=checkpoint)
     elapsed = time.perf_counter() - t0
 
     rows, models, eta_names = [], [], []

@@ -14,7 +14,7 @@ from typing import Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from .._validate import as_float, as_int, as_real_1d
+from .._validate import as_float, as_int, as_path, as_real_1d
 from ..data import FrequencyData
 from ..examples import noise_variances, noisy_periods
 from ..fds import simulate
@@ -149,7 +149,7 @@ def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, p
                pole_in: float = 0.0, pole_out: float = 0.0, correlation: float = 0.0,
                lines=None, tol: float = 1e-10, max_iter: int = 50, level: float = 0.95, seed=0,
                executor="processes", workers: Optional[int] = None, chunk_size: Optional[int] = None,
-               progress: Optional[bool] = None) -> MonteCarloResult:
+               progress: Optional[bool] = None, checkpoint=None) -> MonteCarloResult:
     """A Monte Carlo study of the estimators on a design: R noise realisations, each fitted.
 
     Realisation r draws P periods of the steady-state input and output of ``model`` under
@@ -185,6 +185,11 @@ def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, p
     executor, workers, chunk_size, progress :
         Where and how the fits run (:func:`lptv.batch.run_tasks`): ``"processes"`` (default,
         all cores), ``"serial"``, a Dask scheduler address or ``distributed.Client``.
+    checkpoint : str or Path, optional
+        A folder where every finished chunk of realisations is written as it completes; a
+        rerun with the same arguments and folder runs only the realisations it lacks (after
+        Ctrl-C, a kill or a lost cluster), and gives the same result, bit for bit, as an
+        uninterrupted run (:mod:`lptv.batch.parts`). A folder of another study is refused.
 
     Returns
     -------
@@ -219,6 +224,8 @@ def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, p
     level = _in_range(level, "level", 0, 1, False)
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=0)
+    if checkpoint is not None:
+        checkpoint = as_path(checkpoint, "checkpoint")
     if isinstance(seed, (bool, float, complex, str, bytes)):
         raise ValueError(f"seed must be an int, a sequence of ints or a SeedSequence, got {seed!r}")
     if not isinstance(seed, np.random.SeedSequence):
@@ -239,7 +246,7 @@ def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, p
     t0 = time.perf_counter()
     out = run_tasks(realisation, list(enumerate(seed.spawn(runs))), design, executor=executor,
                     workers=workers, chunk_size=chunk_size, progress=progress, desc="montecarlo",
-                    unit="fit", weight=len(methods))
+                    unit="fit", weight=len(methods), checkpoint=checkpoint)
     elapsed = time.perf_counter() - t0
 
     n = bound.eta.size

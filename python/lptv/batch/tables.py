@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path
 from .executors import require
 
 _FORMATS = ("csv", "parquet")
@@ -130,14 +131,18 @@ class MonteCarloTables:
         out.mkdir(parents=True, exist_ok=True)
         paths = {"estimates": out / f"estimates.{format}", "fits": out / f"fits.{format}",
                  "summary": out / "summary.csv", "overview": out / "overview.csv"}
+        if format == "parquet":
+            require("pyarrow", "writing Parquet")
+        # each file whole or not at all: a study killed while saving leaves no half table
         for name, frame in (("estimates", self.table()), ("fits", self.fit_table())):
-            if format == "parquet":
-                require("pyarrow", "writing Parquet")
-                frame.to_parquet(paths[name], index=False)
-            else:
-                frame.to_csv(paths[name], index=False)
-        self.summary().to_csv(paths["summary"])
-        self.overview().to_csv(paths["overview"])
+            with atomic_path(paths[name]) as tmp:
+                if format == "parquet":
+                    frame.to_parquet(tmp, index=False)
+                else:
+                    frame.to_csv(tmp, index=False)
+        for name, frame in (("summary", self.summary()), ("overview", self.overview())):
+            with atomic_path(paths[name]) as tmp:
+                frame.to_csv(tmp)
         return paths
 
     def report(self) -> str:

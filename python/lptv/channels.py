@@ -1,0 +1,156 @@
+"""Which arrays of a measurement file are the input, the output and the time, and what they say
+about the sampling frequency (the helpers of :func:`lptv.read_measurements`).
+
+- Channels by name: ``u=`` / ``y=`` (``--input`` / ``--output``) name a CSV column, an NPZ array
+  or a MAT variable; by default ``u`` and ``y``. A wrong name lists what the file holds.
+- The sampling frequency from the file: a time column or variable (``time=``, by default one
+  named ``t`` or ``time``, optionally with its unit: ``time [s]``, ``t_ms``), checked uniform,
+  or a stored scalar ``fs`` (Hz) or ``dt`` / ``Ts`` (s).
+"""
+from __future__ import annotations
+
+import re
+from typing import Dict, Optional, Sequence, Tuple
+
+import numpy as np
+
+
+class FileError(ValueError):
+    """A problem with the input file or the options that the user can act on (a ValueError)."""
+
+
+ROLES = {"u": ("input", "u=", "--input"), "y": ("output", "y=", "--output"), "time": ("time", "time=", "--time")}
+
+_TIME = re.compile(r"^(t|time|timestamp)\s*(?:[\[(]\s*(s|sec|seconds|ms|us)\s*[\])]|[_ ](s|sec|ms|us))?$")
+_UNIT = {"s": 1.0, "sec": 1.0, "seconds": 1.0, "ms": 1e-3, "us": 1e-6, None: 1.0}
+# Stored sampling variables (exact names): Hz, or seconds per sample.
+FS_NAMES = ("fs", "Fs", "FS")
+DT_NAMES = ("dt", "Ts", "ts", "DT", "TS")
+# A time step may deviate from the mean step by this fraction (text files round the times).
+STEP_TOLERANCE = 1e-3
+
+
+def channel_name(x, role):
+    """A channel name argument (None: the default), or FileError naming the argument."""
+    word, kw, opt = ROLES[role]
+    if x is None:
+        return None
+    if role == "y" and isinstance(x, (list, tuple)):
+        if len(x) == 1:
+            x = x[0]
+        elif len(x) > 1 and all(isinstance(v, str) for v in x):
+            raise FileError(one_output_message(list(x)))
+    if not isinstance(x, str) or not x.strip():
+        raise FileError(f"{kw} ({opt}) must name a channel of the file (a non-empty str), got {x!r}")
+    return x.strip()
+
+
+def one_output_message(names):
+    listed = ", ".join(repr(n) for n in names)
+    return (f"y= (--output) must name one output channel, got {len(names)} ({listed}): lptv fits one output "
+            "at a time (MIMO models are not supported yet); run once per output channel")
+
+
+def find(wanted: str, available: Sequence[str], role: str, kind: str, shown) -> str:
+    """The file's name for a wanted channel: exact, else the one name equal up to case and
+    spaces; FileError listing the file's channels (``shown``, a str or a function giving one)
+    otherwise."""
+    if wanted in available:
+        return wanted
+    key = wanted.strip().lower()
+    near = [a for a in available if a.strip().lower() == key]
+    if len(near) == 1:
+        return near[0]
+    if len(near) > 1:
+        raise FileError(f"{kind} '{wanted}' is ambiguous: the file has {', '.join(repr(n) for n in near)}")
+    if role == "y" and "," in wanted:
+        parts = [p.strip() for p in wanted.split(",") if p.strip()]
+        if len(parts) > 1:
+            raise FileError(one_output_message(parts))
+    word, kw, opt = ROLES[role]
+    shown = shown() if callable(shown) else shown
+    if wanted == role:
+        raise FileError(f"{kind} '{wanted}' is missing ({shown}); name the input and output channels with "
+                        "--input NAME --output NAME (u=, y= of lptv.read_measurements)")
+    raise FileError(f"{kind} '{wanted}', the {word} named by {opt} ({kw}), is missing ({shown})")
+
+
+def time_unit(name: str) -> Optional[float]:
+    """Seconds per unit of a column named like a time (t, time, time [s], t_ms ...), else None."""
+    m = _TIME.match(name.strip().lower())
+    if not m:
+        return None
+    return _UNIT[m.group(2) or m.group(3)]
+
+
+def auto_time(available: Sequence[str], exclude=()) -> Optional[str]:
+    """The first channel named like a time, not one of the exclude."""
+    return next((a for a in available if a not in exclude and time_unit(a) is not None), None)
+
+
+def fs_from_time(t, what: str, scale: float = 1.0, line_of=None) -> float:
+    """The sampling frequency of a time vector (s per unit ``scale``), checked uniform: FileError
+    naming the first sample whose step differs from the mean step by more than 0.1 %."""
+    t = np.asarray(t, dtype=float).ravel() * scale
+    if t.size < 2:
+        raise FileError(f"{what} holds {t.size} sample(s); a time needs at least 2 to give the sampling frequency")
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise FileError(f"{what} is NaN or inf at {_where(bad[0], line_of)}")
+    d = np.diff(t)
+    step = float(np.median(d))      # the record's step, whatever a few samples do
+    if not step > 0:
+        raise FileError(f"{what} does not increase (median step {step:.6g} s)")
+    off = np.flatnonzero(np.abs(d - step) > STEP_TOLERANCE * step)
+    if off.size:
+        i = off[0] + 1
+        raise FileError(f"{what} is not uniformly sampled: {_where(i, line_of)} is at {t[i]:.10g} s, "
+                        f"{d[i - 1]:.6g} s after the previous one, where the record's step is {step:.6g} s "
+                        f"(fs {1 / step:.6g} Hz); resample the record or give --fs")
+    return _tidy((t.size - 1) / (t[-1] - t[0]))     # the mean step: rounding of the times averages out
+
+
+def _where(i, line_of):
+    return f"sample {i + 1}" + (f" (line {line_of[i]})" if line_of is not None else "")
+
+
+def _tidy(fs):
+    """fs rounded to 9 significant digits when that is a round number (times written as text)."""
+    r = float(f"{fs:.9g}")
+    return r if abs(r - fs) <= 1e-9 * fs else fs
+
+
+def stored_fs(values: Dict[str, object]) -> Optional[Tuple[float, str]]:
+    """(fs, 'variable NAME') from stored scalars fs / dt / Ts, checked positive and in agreement."""
+    found = []
+    for name in FS_NAMES + DT_NAMES:
+        if name not in values:
+            continue
+        a = np.asarray(values[name])
+        if a.dtype.kind not in "fiu" or a.size != 1 or not np.isfinite(a.item()) or a.item() <= 0:
+            unit = "Hz" if name in FS_NAMES else "s"
+            raise FileError(f"variable '{name}' must be a positive scalar ({unit}), the sampling "
+                            f"{'frequency' if name in FS_NAMES else 'time'}; got {_describe(a)}")
+        v = float(a.item())
+        found.append((v if name in FS_NAMES else 1.0 / v, name))
+    if not found:
+        return None
+    fs, name = found[0]
+    for other, oname in found[1:]:
+        if not np.isclose(other, fs, rtol=1e-6, atol=0):
+            raise FileError(f"variables '{name}' and '{oname}' disagree: fs {fs:.10g} Hz against {other:.10g} Hz")
+    return fs, f"variable '{name}'"
+
+
+def _describe(a):
+    if a.dtype.kind in "fiu" and a.size == 1:
+        return repr(a.item())
+    return f"an array of shape {a.shape} and dtype {a.dtype}" if a.size != 1 else f"dtype {a.dtype}"
+
+
+def listing(shapes: Dict[str, Optional[tuple]]) -> str:
+    """'the file has force (1 x 5000), disp (1 x 5000), fs (1 x 1)' from {name: shape or None}."""
+    if not shapes:
+        return "the file has none"
+    parts = [k if s is None else f"{k} ({' x '.join(map(str, s)) or 'scalar'})" for k, s in shapes.items()]
+    return "the file has " + ", ".join(parts)

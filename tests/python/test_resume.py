@@ -1,0 +1,251 @@
+"""Studies that survive an interruption: each finished chunk is on disk as it completes, SIGINT
+and SIGTERM end the command in one line with status 130 / 143, and --resume completes the study
+to the very table of an uninterrupted run (compared byte for byte with the library's own run)."""
+import csv
+import concurrent.futures as cf
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import lptv
+from lptv.apps import cli
+from lptv.atomic import atomic_open
+from lptv.batch import run_tasks
+from lptv.batch.parts import CheckpointError, stored_items
+from lptv.examples import paper_measurements
+
+pd = pytest.importorskip("pandas")
+
+LPTV = [sys.executable, "-m", "lptv"]
+RUNS = 1200
+MODEL = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)          # 1 / (s + 2): fits of ~3 ms
+
+
+def study_args(out, *extra):
+    return ["montecarlo", "--model", str(out.parent / "model.json"), "--excited", "1-20", "--samples", "128",
+            "--runs", str(RUNS), "--periods", "4", "--method", "sml", "--seed", "5", "--chunk-size", "20",
+            "--workers", "2", "--out", str(out), *extra]
+
+
+def parts_in(out):
+    return len(list((out / "parts").glob("part-*.json")))
+
+
+def start_and_signal(argv, out, sig, more_than):
+    """Start the command, wait until it has written more than ``more_than`` parts, send ``sig``."""
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while parts_in(out) <= more_than and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert p.poll() is None, "the study ended before it could be interrupted: make it longer"
+    p.send_signal(sig)
+    stdout, stderr = p.communicate(timeout=120)
+    return p.returncode, stdout, stderr
+
+
+def test_montecarlo_interrupted_twice_then_resumed_gives_the_uninterrupted_table(tmp_path):
+    MODEL.save(tmp_path / "model.json")
+    out = tmp_path / "mc"
+    rc, stdout, stderr = start_and_signal(LPTV + study_args(out), out, signal.SIGINT, 0)
+    assert rc == 130, stderr
+    assert "Traceback" not in stderr and stderr.count("\n") == 1, stderr
+    kept = stored_items(out / "parts")
+    assert 0 < kept < RUNS and kept % 20 == 0
+    assert f"interrupted by SIGINT: {kept} of {RUNS} realisations are kept in {out / 'parts'}/" in stderr
+    assert not (out / "estimates.csv").exists()
+    # the resumed run is stopped again, by SIGTERM this time, and keeps what it adds
+    rc, stdout, stderr = start_and_signal(LPTV + study_args(out, "--resume"), out, signal.SIGTERM,
+                                          parts_in(out))
+    assert rc == 143 and "interrupted by SIGTERM" in stderr and stderr.count("\n") == 1, stderr
+    assert f"resuming: {kept} of {RUNS} realisations are done" in stdout
+    assert stored_items(out / "parts") > kept
+    p = subprocess.run(LPTV + study_args(out, "--resume"), capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert stored_items(out / "parts") == RUNS
+    # the library's uninterrupted run of the same study, serially, in this process
+    ms = lptv.multisine(range(1, 21), 128, amplitudes=np.sqrt(2 / 20), seed=1)
+    ref = lptv.montecarlo(MODEL, ms, periods=4, runs=RUNS, methods="sml", snr_in_db=50, snr_out_db=30,
+                          pole_in=0.6, pole_out=0.8, correlation=0.5, seed=5, executor="serial", progress=False)
+    ref.save(tmp_path / "ref")
+    for name in ("estimates.csv", "fits.csv", "summary.csv"):
+        assert (out / name).read_bytes() == (tmp_path / "ref" / name).read_bytes(), name
+
+
+def test_a_rerun_of_another_study_replaces_the_parts_and_resume_refuses_it(tmp_path, capsys):
+    MODEL.save(tmp_path / "model.json")
+    out = tmp_path / "mc"
+    small = ["montecarlo", "--model", str(tmp_path / "model.json"), "--excited", "1-20", "--samples", "128",
+             "--runs", "6", "--periods", "4", "--workers", "1", "--out", str(out)]
+    assert cli.main(small) == 0
+    assert cli.main(small + ["--resume"]) == 0            # all done: nothing to fit, same tables
+    stdout = capsys.readouterr().out
+    assert "resuming: 6 of 6 realisations are done" in stdout
+    rc = cli.main(small + ["--seed", "7", "--resume"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "holds the parts of another study" in err and err.count("\n") == 1
+    assert cli.main(small + ["--seed", "7"]) == 0          # without --resume: a new study
+    assert "held the parts of another study: replaced" in capsys.readouterr().out
+    rc = cli.main(small[:-1] + [str(tmp_path / "new"), "--resume"])
+    assert rc == 2 and "--resume: " in capsys.readouterr().err
+
+
+def test_identify_files_resume_fits_only_the_missing_files(tmp_path, capsys):
+    files = []
+    for s in range(1, 7):
+        d = paper_measurements(seed=s, periods=4)
+        files.append(str(tmp_path / f"rec{s}.npz"))
+        np.savez(files[-1], u=d["u"], y=d["y"], w0=d["w0"])
+    args = ["identify", *files, "--na", "2", "--nb", "1", "--ka", "3", "--kb", "3", "--lines", "1-243",
+            "--workers", "1"]
+    assert cli.main(args + ["--out", str(tmp_path / "ref")]) == 0
+    out = tmp_path / "b"
+    assert cli.main(args + ["--out", str(out)]) == 0
+    parts = sorted((out / "parts").glob("part-*.json"))
+    assert len(parts) > 1
+    for p in parts[1:]:
+        p.unlink()                                      # as if stopped after the first chunk
+    (out / "results.csv").unlink()
+    capsys.readouterr()
+    assert cli.main(args + ["--out", str(out), "--resume"]) == 0
+    stdout = capsys.readouterr().out
+    first = json.loads(parts[0].read_text())["items"]
+    assert f"resuming: {len(first)} of 6 files are fitted" in stdout
+    assert (out / "results.csv").read_bytes() == (tmp_path / "ref" / "results.csv").read_bytes()
+    rc = cli.main(["identify", files[0], "--na", "2", "--nb", "1", "--resume"])
+    assert rc == 2 and "--resume applies to a batch" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------ the library
+
+def square(x, shared):
+    return {"x": x, "v": np.array([x, x ** 0.5]), "t": (x, "ok")}
+
+
+class LosesTheFirstChunk(cf.ThreadPoolExecutor):
+    """An executor whose first task dies, as a chunk on a worker that was killed."""
+
+    def __init__(self):
+        super().__init__(max_workers=2)
+        self.lost = False
+
+    def submit(self, fn, *a, **kw):
+        if not self.lost:
+            self.lost = True
+            f = cf.Future()
+            f.set_exception(RuntimeError("worker killed"))
+            return f
+        return super().submit(fn, *a, **kw)
+
+
+def test_a_lost_chunk_is_not_kept_and_runs_again(tmp_path):
+    items = list(range(10))
+    with LosesTheFirstChunk() as ex:
+        out = run_tasks(square, items, None, executor=ex, chunk_size=3, progress=False, checkpoint=tmp_path)
+    lost = [i for i, r in enumerate(out) if isinstance(r, lptv.batch.Failure)]
+    assert lost == [0, 1, 2] and out[0].message.startswith("task lost: RuntimeError: worker killed")
+    assert stored_items(tmp_path) == 7
+    again = run_tasks(square, items, None, executor="serial", progress=False, checkpoint=tmp_path)
+    ref = [square(x, None) for x in items]
+    for a, b in zip(again, ref):          # read back exactly: floats, arrays, tuples
+        assert a["x"] == b["x"] and a["t"] == b["t"] and a["v"].dtype == b["v"].dtype
+        assert np.array_equal(a["v"], b["v"])
+    with pytest.raises(CheckpointError, match="another study"):
+        run_tasks(square, items[:9], None, executor="serial", progress=False, checkpoint=tmp_path)
+
+
+def test_atomic_open_leaves_the_old_file_when_the_writer_fails(tmp_path):
+    target = tmp_path / "table.csv"
+    target.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_open(target) as f:
+            f.write("half a new ta")
+            raise RuntimeError("killed")
+    assert target.read_text() == "old" and os.listdir(tmp_path) == ["table.csv"]
+    with atomic_open(target) as f:
+        f.write("new")
+    assert target.read_text() == "new" and oct(target.stat().st_mode & 0o777) != "0o600"
+
+
+# ------------------------------------------------------------------------------ a cluster's faults
+
+def test_a_dask_worker_killed_mid_study_costs_only_its_chunk(tmp_path):
+    """A LocalCluster worker killed by its pid while the study runs: its chunk runs again on
+    another worker, and the study is complete and identical to the serial one."""
+    distributed = pytest.importorskip("distributed")
+    import threading
+
+    ms = lptv.multisine(range(1, 21), 128, amplitudes=np.sqrt(2 / 20), seed=1)
+    kw = dict(periods=4, runs=600, methods="sml", snr_in_db=50, snr_out_db=30, seed=3, progress=False)
+    parts = tmp_path / "parts"
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                  host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
+        box = {}
+        run = threading.Thread(target=lambda: box.update(mc=lptv.montecarlo(
+            MODEL, ms, executor=client, chunk_size=10, checkpoint=parts, **kw)))
+        run.start()
+        deadline = time.monotonic() + 120
+        while (stored_items(parts) or 0) < 40 and run.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        pids = client.run(os.getpid)
+        done_at_kill = stored_items(parts)
+        os.kill(sorted(pids.values())[0], signal.SIGKILL)
+        run.join(timeout=300)
+    assert done_at_kill < kw["runs"], "the study ended before the worker was killed: make it longer"
+    mc = box["mc"]
+    assert all(f["ok"] for f in mc.fits)
+    ref = lptv.montecarlo(MODEL, ms, executor="serial", **kw)
+    pd.testing.assert_frame_equal(mc.table(), ref.table())
+    pd.testing.assert_frame_equal(mc.fit_table(), ref.fit_table())
+
+
+CLUSTER = """
+import sys, time, distributed
+if __name__ == "__main__":
+    c = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                 host="127.0.0.1")
+    print(c.scheduler_address, flush=True)
+    time.sleep(600)
+"""
+
+
+def test_a_lost_scheduler_ends_the_study_keeping_the_finished_chunks(tmp_path):
+    """The scheduler and its worker are killed mid-study: one line saying what is kept and how to
+    resume, exit status 1, no tables; --resume (here on local processes) completes the study."""
+    pytest.importorskip("distributed")
+    MODEL.save(tmp_path / "model.json")
+    (tmp_path / "cluster.py").write_text(CLUSTER)
+    cluster = subprocess.Popen([sys.executable, str(tmp_path / "cluster.py")], stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True, start_new_session=True)
+    try:
+        address = cluster.stdout.readline().strip()
+        assert address.startswith("tcp://"), address
+        out = tmp_path / "mc"
+        argv = study_args(out)
+        argv[argv.index("--workers"):argv.index("--workers") + 2] = ["--scheduler", address]
+        p = subprocess.Popen(LPTV + argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 120
+        while parts_in(out) < 3 and p.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert p.poll() is None, "the study ended before the scheduler was killed"
+        os.killpg(cluster.pid, signal.SIGKILL)       # the scheduler, its nanny and worker
+        stdout, stderr = p.communicate(timeout=120)
+    finally:
+        if cluster.poll() is None:
+            os.killpg(cluster.pid, signal.SIGKILL)
+        cluster.wait()
+    kept = stored_items(out / "parts")
+    assert p.returncode == 1, stderr
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
+    assert f"{RUNS - kept} of {RUNS} realisations were lost" in stderr
+    assert f"the {kept} finished are kept in {out / 'parts'}/: rerun the same command with --resume" in stderr
+    assert not (out / "estimates.csv").exists()
+    r = subprocess.run(LPTV + study_args(out, "--resume"), capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and f"resuming: {kept} of {RUNS}" in r.stdout, r.stderr
+    with open(out / "fits.csv") as f:
+        assert sum(row["ok"] == "True" for row in csv.DictReader(f)) == RUNS
