@@ -1,0 +1,209 @@
+"""The wheel of ``make wheel``: manylinux, self-contained, installable without root or apt.
+
+``make wheel`` repairs the wheel with auditwheel into build/wheel/ and runs this file
+(LPTV_WHEEL_DIR names that folder; its constraints.txt holds the versions of the Makefile's
+PIP_PINS). The checks:
+
+- ``auditwheel show``: a manylinux tag, and every shared library the wheel takes from the system
+  is one the manylinux policy allows (libc, libm, libstdc++, libgcc_s); SuiteSparse, OpenBLAS
+  and its LAPACK, libgfortran and the rest travel in ``lptv.libs/``.
+- The wheel is installed with pip into a fresh venv (its dependencies from PyPI, no apt step),
+  and ``ldd`` of the installed module resolves every library outside the policy into the
+  installed ``lptv.libs/``.
+- The README's first Python example and ``lptv demo`` run from that venv with the Debian
+  libraries hidden from the loader: in a private mount namespace (``unshare``, no root needed
+  where user namespaces are allowed) an empty file is bound over every library the development
+  build takes from the system outside the policy. The development build then fails to import
+  (the hiding works); the installed wheel runs, and /proc/self/maps shows none of the hidden
+  files loaded.
+"""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+from importlib import resources
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+WHEEL_DIR = Path(os.environ.get("LPTV_WHEEL_DIR", ROOT / "build" / "wheel"))
+BIN = Path(sys.executable).parent          # the development venv's tools (auditwheel)
+# Libraries that must travel in lptv.libs/ (SuiteSparse, OpenBLAS and its LAPACK); auditwheel
+# names each copy <name>-<8 hex digits of its hash>.<version>.so or .so.<version>
+MUST_BUNDLE = ("libcholmod", "libumfpack", "libklu", "libamd", "libopenblas", "liblapack")
+
+
+def _is_copy(name, stem):
+    return re.match(re.escape(stem) + r"[\w.-]*-[0-9a-f]{8}\.", name) is not None
+
+
+def _run(argv, **kw):
+    r = subprocess.run([str(a) for a in argv], capture_output=True, text=True, **kw)
+    assert r.returncode == 0, f"{argv}: exit {r.returncode}\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}"
+    return r
+
+
+@pytest.fixture(scope="module")
+def wheel():
+    wheels = sorted(WHEEL_DIR.glob("lptv-*-manylinux_*.whl"))
+    assert len(wheels) == 1, f"expected one repaired wheel in {WHEEL_DIR} (make wheel), got {wheels}"
+    return wheels[0]
+
+
+@pytest.fixture(scope="module")
+def show(wheel):
+    return json.loads(_run([BIN / "auditwheel", "show", "--json", wheel]).stdout)
+
+
+def _policy(tag):
+    """The manylinux policy of a tag (e.g. manylinux_2_35_x86_64), as auditwheel ships it."""
+    text = (resources.files("auditwheel.policy") / "manylinux-policy.json").read_text()
+    name = re.sub(r"_x86_64$", "", tag)
+    (policy,) = [p for p in json.loads(text) if p["name"] == name or name in p["aliases"]]
+    return policy
+
+
+def _bundled(wheel):
+    with zipfile.ZipFile(wheel) as z:
+        return {Path(n).name for n in z.namelist() if n.startswith("lptv.libs/")}
+
+
+def _ldd(path):
+    """{soname: resolved path} of an ELF file, by the system's loader (ldd)."""
+    out = _run(["ldd", path]).stdout
+    return {m[0]: m[1] for m in re.findall(r"^\s*(\S+) => (\S+)", out, flags=re.M)}
+
+
+def test_auditwheel_show_lists_nothing_outside_the_policy(wheel, show):
+    tag = show["overall_tag"]
+    assert tag.startswith("manylinux_") and wheel.name.endswith(f"-{tag}.whl")
+    assert show["external_libs"] == {}
+    allowed = set(_policy(tag)["lib_whitelist"])
+    bundled = _bundled(wheel)
+    for lib in show["versioned_symbols"]:
+        assert lib in allowed or lib in bundled, lib
+    for stem in MUST_BUNDLE:
+        assert any(_is_copy(n, stem) for n in bundled), (stem, sorted(bundled))
+    text = _run([BIN / "auditwheel", "-v", "show", wheel]).stdout
+    assert "The wheel requires no external shared libraries" in text
+    assert f'consistent with\nthe following platform tag: "{tag}"' in text or f'"{tag}"' in text
+    with zipfile.ZipFile(wheel) as z:  # Eigen is a build-time dependency only: no headers shipped
+        assert not [n for n in z.namelist() if "Eigen" in n or n.endswith((".h", ".hpp"))]
+
+
+@pytest.fixture(scope="module")
+def venv(wheel, tmp_path_factory):
+    """A fresh venv with the wheel installed by pip (no root, no apt, no build)."""
+    path = tmp_path_factory.mktemp("fresh") / "venv"
+    _run([sys.executable, "-m", "venv", path])
+    constraints = WHEEL_DIR / "constraints.txt"
+    pin = ["-c", constraints] if constraints.exists() else []
+    _run([path / "bin" / "python", "-m", "pip", "install", "-q", "--disable-pip-version-check",
+          "--only-binary", ":all:", *pin, f"{wheel}[plots,timedomain]"], timeout=900)
+    return path
+
+
+def _installed_core(venv):
+    out = _run([venv / "bin" / "python", "-c", "import lptv._core as c; print(c.__file__)"],
+               cwd=venv).stdout
+    return Path(out.strip().splitlines()[-1])
+
+
+def test_installed_module_resolves_to_its_own_libraries(venv, show):
+    core = _installed_core(venv)
+    assert core.is_relative_to(venv), core
+    libs_dir = (core.parent.parent / "lptv.libs").resolve()
+    allowed = set(_policy(show["overall_tag"])["lib_whitelist"])
+    files = [core, *libs_dir.iterdir()]
+    for elf in files:
+        for name, where in _ldd(elf).items():
+            if name in allowed:
+                continue
+            assert Path(where).resolve().parent == libs_dir, f"{elf.name} takes {name} from {where}"
+    names = {f.name for f in libs_dir.iterdir()}
+    for stem in MUST_BUNDLE:
+        assert any(_is_copy(n, stem) for n in names), stem
+
+
+@pytest.fixture(scope="module")
+def hidden(show):
+    """The files the development build's module loads from the system outside the policy."""
+    import lptv._core
+
+    allowed = set(_policy(show["overall_tag"])["lib_whitelist"])
+    files = sorted({os.path.realpath(p) for n, p in _ldd(lptv._core.__file__).items() if n not in allowed})
+    for stem in ("libcholmod", "libumfpack", "libklu", "libopenblas", "liblapack"):
+        assert any(Path(f).name.startswith(stem) for f in files), (stem, files)
+    return files
+
+
+def _run_hidden(argv, hidden, tmp_path, **kw):
+    """argv in a private mount namespace where every file of ``hidden`` is empty."""
+    if shutil.which("unshare") is None:
+        pytest.skip("no unshare (util-linux) to hide the Debian libraries")
+    probe = subprocess.run(["unshare", "--mount", "--map-root-user", "true"], capture_output=True)
+    if probe.returncode != 0:
+        pytest.skip(f"unshare --mount --map-root-user is not allowed here: {probe.stderr.decode()[-300:]}")
+    empty = tmp_path / "empty"
+    empty.write_bytes(b"")
+    script = ('e=$1; shift; while [ "$1" != -- ]; do mount --bind "$e" "$1" || exit 97; shift; done; '
+              'shift; exec "$@"')
+    env = {k: v for k, v in os.environ.items() if k not in ("LD_LIBRARY_PATH", "LD_PRELOAD", "PYTHONPATH")}
+    env.update(MPLBACKEND="Agg", PATH="/usr/bin:/bin")
+    cmd = ["unshare", "--mount", "--map-root-user", "sh", "-c", script, "sh", str(empty), *hidden, "--",
+           *map(str, argv)]
+    return subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, env=env, **kw)
+
+
+def test_the_development_build_needs_the_hidden_libraries(hidden, tmp_path):
+    """The control: with the Debian libraries hidden, the module built against them cannot load."""
+    r = _run_hidden([sys.executable, "-c", "import lptv._core"], hidden, tmp_path)
+    assert r.returncode not in (0, 97), r.stderr
+    assert "ImportError" in r.stderr and ("file too short" in r.stderr or "cannot open" in r.stderr), r.stderr
+
+
+README_RUN = r'''
+import json, re, sys
+from pathlib import Path
+
+block = re.findall(r"```python\n(.*?)```", Path(sys.argv[1]).read_text(), flags=re.S)[0]
+ns = {}
+exec(compile(block, "README.md", "exec"), ns)
+import lptv, lptv._core
+maps = sorted({line.split()[-1] for line in open("/proc/self/maps") if ".so" in line})
+res = ns["res"]
+print(json.dumps({"lptv": lptv.__file__, "core": lptv._core.__file__, "maps": maps,
+                  "converged": bool(res.converged), "residue_ok": bool(res.residue_ok)}))
+'''
+
+
+def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(venv, hidden, tmp_path):
+    script = tmp_path / "readme_example.py"
+    script.write_text(README_RUN)
+    r = _run_hidden([venv / "bin" / "python", script, ROOT / "README.md"], hidden, tmp_path, timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert out["converged"] and out["residue_ok"]
+    assert Path(out["lptv"]).is_relative_to(venv) and Path(out["core"]).is_relative_to(venv)
+    assert (tmp_path / "model.json").exists()
+    libs_dir = (Path(out["core"]).parent.parent / "lptv.libs").resolve()
+    loaded = [Path(p).resolve() for p in out["maps"]]
+    assert not set(map(str, loaded)) & set(hidden), "a hidden library was loaded"
+    for stem in MUST_BUNDLE:  # the bundled copies are the ones in memory
+        assert any(p.parent == libs_dir and _is_copy(p.name, stem) for p in loaded), stem
+    for p in loaded:
+        if any(p.name.startswith(stem) for stem in ("libcholmod", "libumfpack", "libklu", "liblapack")):
+            assert p.parent == libs_dir, p
+
+
+def test_lptv_demo_runs_from_the_wheel_with_the_debian_libraries_hidden(venv, hidden, tmp_path):
+    r = _run_hidden([venv / "bin" / "lptv", "demo", "--out", tmp_path / "demo"], hidden, tmp_path,
+                    timeout=600)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
+    assert "done in" in r.stdout
+    for name in ("report.html", "summary.json", "model_wgtls.json"):
+        assert (tmp_path / "demo" / name).stat().st_size > 0, name
