@@ -11,6 +11,9 @@ parameter, the poles with their damping, a Bode plot with the model's 95 % band 
 simulated against the measured output. ``lptv identify record.csv --fs 100 --period 10 --na 2
 --nb 0 --method sml`` does the same from the command line and writes a report.
 """
+import tempfile
+from pathlib import Path
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -25,12 +28,13 @@ y1 = lptv.time_signal(lptv.simulate(rig, ms.spectrum), N)
 rng = np.random.default_rng(1)
 u = np.tile(ms.signal, P) + 0.01 * ms.signal.std() * rng.standard_normal(P * N)
 y = np.tile(y1, P) + 0.03 * y1.std() * rng.standard_normal(P * N)
-np.savetxt("record.csv", np.column_stack([u, y]), delimiter=",", header="u,y", comments="")
+record = Path(tempfile.mkdtemp()) / "record.csv"
+np.savetxt(record, np.column_stack([u, y]), delimiter=",", header="u,y", comments="")
 
 # %%
 # Read, check, identify
 # ---------------------
-m = lptv.read_measurements("record.csv", fs=fs, period=period)
+m = lptv.read_measurements(record, fs=fs, period=period)
 print("periods x samples:", m.u.shape)
 check = lptv.check_record(m.u, m.y)   # a start-up transient? periods cut at the wrong length?
 print(f"first period against the others: {check.transient_ratio:.2f} (a transient above "
