@@ -67,7 +67,7 @@ sphinx_gallery_conf = {
 _PAGES = {"readme": "README.md", "method": "METHOD.md", "design": "DESIGN.md",
           "results": "bench/RESULTS.md"}
 _LINKS = {"bench/RESULTS.md": "results.md", "DESIGN.md": "design.md", "METHOD.md": "method.md"}
-_CODE_SPAN = re.compile(r"(`+).*?\1")
+_CODE_SPAN = re.compile(r"(`+)(?:(?!\n[ \t]*\n)[\s\S])*?\1")   # may span lines, not paragraphs
 _WORD_STAR = re.compile(r"(?<=[A-Za-z0-9])\*(?=[A-Za-z0-9])")
 
 
@@ -76,22 +76,30 @@ def _plain_maths(text):
     into emphasis across a formula: outside code every underscore (none marks emphasis there)
     and every star between two word characters is escaped. Fenced and indented code, and code
     spans, are left as they are."""
-    out, fenced, code = [], False, False
+    out, prose, fenced, code = [], [], False, False
+
+    def flush():
+        if prose:
+            chunk, pos, parts = "\n".join(prose), 0, []
+            for m in _CODE_SPAN.finditer(chunk):
+                parts += [_escape(chunk[pos:m.start()]), m.group(0)]
+                pos = m.end()
+            out.extend("".join(parts + [_escape(chunk[pos:])]).split("\n"))
+            prose.clear()
+
+    previous = ""
     for line in text.split("\n"):
-        if line.lstrip().startswith("```"):
-            fenced = not fenced
-        blank_before = not out or not out[-1].strip()
-        code = line.startswith("    ") and (blank_before or code) and not fenced
-        if fenced or code or line.lstrip().startswith("```"):
+        fence = line.lstrip().startswith("```")
+        code = line.startswith("    ") and (not previous.strip() or code) and not fenced
+        if fenced or fence or code:
+            flush()
             out.append(line)
-            continue
-        parts, pos = [], 0
-        for m in _CODE_SPAN.finditer(line):
-            parts.append(_escape(line[pos:m.start()]))
-            parts.append(m.group(0))
-            pos = m.end()
-        parts.append(_escape(line[pos:]))
-        out.append("".join(parts))
+        else:
+            prose.append(line)
+        if fence:
+            fenced = not fenced
+        previous = line
+    flush()
     return "\n".join(out)
 
 
