@@ -10,7 +10,8 @@ PIP_PINS). The checks:
 - The wheel is installed with pip into a fresh venv (its dependencies from PyPI, no apt step),
   and ``ldd`` of the installed module resolves every library outside the policy into the
   installed ``lptv.libs/``.
-- The README's first Python example and ``lptv demo`` run from that venv with the Debian
+- The README's first Python example (from a venv with the wheel, NumPy and SciPy only) and
+  ``lptv demo`` (with the extras it uses: matplotlib, scikit-sundae) run with the Debian
   libraries hidden from the loader: in a private mount namespace (``unshare``, no root needed
   where user namespaces are allowed) an empty file is bound over every library the development
   build takes from the system outside the policy. The development build then fails to import
@@ -95,16 +96,27 @@ def test_auditwheel_show_lists_nothing_outside_the_policy(wheel, show):
         assert not [n for n in z.namelist() if "Eigen" in n or n.endswith((".h", ".hpp"))]
 
 
-@pytest.fixture(scope="module")
-def venv(wheel, tmp_path_factory):
-    """A fresh venv with the wheel installed by pip (no root, no apt, no build)."""
+def _fresh_venv(tmp_path_factory, requirement):
+    """A fresh venv with ``requirement`` installed by pip (no root, no apt, no build)."""
     path = tmp_path_factory.mktemp("fresh") / "venv"
     _run([sys.executable, "-m", "venv", path])
     constraints = WHEEL_DIR / "constraints.txt"
     pin = ["-c", constraints] if constraints.exists() else []
     _run([path / "bin" / "python", "-m", "pip", "install", "-q", "--disable-pip-version-check",
-          "--only-binary", ":all:", *pin, f"{wheel}[plots,timedomain]"], timeout=900)
+          "--only-binary", ":all:", *pin, requirement], timeout=900)
     return path
+
+
+@pytest.fixture(scope="module")
+def bare(wheel, tmp_path_factory):
+    """The wheel alone: lptv with NumPy and SciPy, its only requirements."""
+    return _fresh_venv(tmp_path_factory, str(wheel))
+
+
+@pytest.fixture(scope="module")
+def venv(wheel, tmp_path_factory):
+    """The wheel with the extras lptv demo uses: matplotlib (plots) and scikit-sundae (timedomain)."""
+    return _fresh_venv(tmp_path_factory, f"{wheel}[plots,timedomain]")
 
 
 def _installed_core(venv):
@@ -181,7 +193,9 @@ print(json.dumps({"lptv": lptv.__file__, "core": lptv._core.__file__, "maps": ma
 '''
 
 
-def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(venv, hidden, tmp_path):
+def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(bare, hidden, tmp_path):
+    """The README's first example in the venv that holds the wheel and NumPy and SciPy only."""
+    venv = bare
     script = tmp_path / "readme_example.py"
     script.write_text(README_RUN)
     r = _run_hidden([venv / "bin" / "python", script, ROOT / "README.md"], hidden, tmp_path, timeout=600)
@@ -198,6 +212,13 @@ def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(ven
     for p in loaded:
         if any(p.name.startswith(stem) for stem in ("libcholmod", "libumfpack", "libklu", "liblapack")):
             assert p.parent == libs_dir, p
+
+
+def test_lptv_demo_without_its_extras_names_them(bare, tmp_path):
+    r = subprocess.run([bare / "bin" / "lptv", "demo", "--out", tmp_path / "demo"], capture_output=True,
+                       text=True, cwd=tmp_path)
+    assert r.returncode == 2 and "pip install 'lptv[plots]'" in r.stderr, r.stderr[-2000:]
+    assert len(r.stderr.strip().splitlines()) == 1
 
 
 def test_lptv_demo_runs_from_the_wheel_with_the_debian_libraries_hidden(venv, hidden, tmp_path):
