@@ -19,8 +19,10 @@ BUILDROOT ?= build
 BUILD := $(BUILDROOT)/cpp
 PREFIX := $(CURDIR)/$(BUILDROOT)/install
 
-# chromium: the test that renders report.html in a headless browser (about 2 minutes to install)
-APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2 chromium
+# chromium: the test that renders report.html in a headless browser (about 2 minutes to install);
+# python3-venv: the wheel's test installs it as an unprivileged user, with Debian's python3
+APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2 chromium \
+	python3-venv
 APT_BENCH := libsundials-dev
 # Python tools and test dependencies, pinned (the package's own runtime
 # dependencies are in pyproject.toml; the last line is its "batch" extra and python-control).

@@ -7,9 +7,11 @@ PIP_PINS). The checks:
 - ``auditwheel show``: a manylinux tag, and every shared library the wheel takes from the system
   is one the manylinux policy allows (libc, libm, libstdc++, libgcc_s); SuiteSparse, OpenBLAS
   and its LAPACK, libgfortran and the rest travel in ``lptv.libs/``.
-- The wheel is installed with pip into a fresh venv (its dependencies from PyPI, no apt step),
-  and ``ldd`` of the installed module resolves every library outside the policy into the
-  installed ``lptv.libs/``.
+- The wheel is installed with pip into fresh venvs, without root: when the tests run as root
+  (CI), pip and every run below go as the unprivileged user nobody (``setpriv``). The wheels of
+  its dependencies are fetched first (pip's cache or PyPI, at the versions of PIP_PINS), the
+  installs use only those (``--no-index``); no apt step. ``ldd`` of the installed module
+  resolves every library outside the policy into the installed ``lptv.libs/``.
 - The README's first Python example (from a venv with the wheel, NumPy and SciPy only) and
   ``lptv demo`` (with the extras it uses: matplotlib, scikit-sundae) run with the Debian
   libraries hidden from the loader: in a private mount namespace (``unshare``, no root needed
@@ -24,6 +26,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import zipfile
 from importlib import resources
 from pathlib import Path
@@ -96,27 +99,98 @@ def test_auditwheel_show_lists_nothing_outside_the_policy(wheel, show):
         assert not [n for n in z.namelist() if "Eigen" in n or n.endswith((".h", ".hpp"))]
 
 
-def _fresh_venv(tmp_path_factory, requirement):
-    """A fresh venv with ``requirement`` installed by pip (no root, no apt, no build)."""
-    path = tmp_path_factory.mktemp("fresh") / "venv"
-    _run([sys.executable, "-m", "venv", path])
-    constraints = WHEEL_DIR / "constraints.txt"
-    pin = ["-c", constraints] if constraints.exists() else []
-    _run([path / "bin" / "python", "-m", "pip", "install", "-q", "--disable-pip-version-check",
-          "--only-binary", ":all:", *pin, requirement], timeout=900)
+UNPRIVILEGED = 65534   # nobody: when the tests run as root, the installs and runs go as this user
+
+
+def _user():
+    """The prefix that drops root for a command (empty for a user who is not root)."""
+    if os.geteuid() != 0:
+        return []
+    assert shutil.which("setpriv"), "setpriv (util-linux) is needed to drop root"
+    return ["setpriv", f"--reuid={UNPRIVILEGED}", f"--regid={UNPRIVILEGED}", "--clear-groups"]
+
+
+def _own(path):
+    path.chmod(0o755)
+    if os.geteuid() == 0:
+        os.chown(path, UNPRIVILEGED, UNPRIVILEGED)
     return path
 
 
 @pytest.fixture(scope="module")
-def bare(wheel, tmp_path_factory):
-    """The wheel alone: lptv with NumPy and SciPy, its only requirements."""
-    return _fresh_venv(tmp_path_factory, str(wheel))
+def home():
+    """A folder the unprivileged user owns: its HOME, the venvs, the working folders."""
+    path = _own(Path(tempfile.mkdtemp(prefix="lptv-wheel-")))
+    yield path
+    shutil.rmtree(path, ignore_errors=True)
+
+
+@pytest.fixture
+def work(home, request):
+    path = home / request.node.name
+    path.mkdir()
+    return _own(path)
+
+
+def _as_user(argv, home, cwd=None, **kw):
+    """argv as the unprivileged user, with a plain environment (no venv, no library path)."""
+    drop = ("LD_LIBRARY_PATH", "LD_PRELOAD", "PYTHONPATH", "VIRTUAL_ENV", "PIP_CACHE_DIR")
+    env = {k: v for k, v in os.environ.items() if k not in drop}
+    env.update(HOME=str(home), PATH="/usr/bin:/bin", MPLBACKEND="Agg", PIP_NO_CACHE_DIR="1")
+    return subprocess.run([*_user(), *map(str, argv)], capture_output=True, text=True,
+                          cwd=cwd or home, env=env, **kw)
+
+
+def _ok(r):
+    assert r.returncode == 0, f"{r.args}: exit {r.returncode}\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}"
+    return r
 
 
 @pytest.fixture(scope="module")
-def venv(wheel, tmp_path_factory):
+def wheels(wheel, home):
+    """The wheel and the wheels of everything it and its two extras need (--only-binary: nothing
+    is built), fetched by pip at the versions of the Makefile's pins."""
+    path = home / "wheels"
+    constraints = WHEEL_DIR / "constraints.txt"
+    pin = ["-c", constraints] if constraints.exists() else []
+    _run([sys.executable, "-m", "pip", "download", "-q", "--disable-pip-version-check", "--only-binary",
+          ":all:", *pin, "-d", path, f"{wheel}[plots,timedomain]"], timeout=900)
+    for p in (path, *path.iterdir()):
+        p.chmod(0o755 if p.is_dir() else 0o644)
+    return path
+
+
+def _interpreter():
+    """The fresh venvs' Python: this one's, or for the unprivileged user Debian's of the same
+    version (this one may sit where only root can read, e.g. /root/.pyenv)."""
+    if os.geteuid() != 0:
+        return sys.executable
+    exe = Path(f"/usr/bin/python{sys.version_info.major}.{sys.version_info.minor}")
+    assert exe.exists(), f"{exe} (Debian's python3 with python3-venv) is needed to test as a user"
+    return exe
+
+
+def _fresh_venv(home, wheels, name, extras=""):
+    """A fresh venv with the wheel installed by pip as the unprivileged user (no root, no apt,
+    no build, no index: the fetched wheels only)."""
+    path = home / name
+    _ok(_as_user([_interpreter(), "-m", "venv", path], home))
+    (wheel,) = wheels.glob("lptv-*.whl")
+    _ok(_as_user([path / "bin" / "python", "-m", "pip", "install", "-q", "--disable-pip-version-check",
+                  "--no-index", "--find-links", wheels, f"{wheel}{extras}"], home, timeout=900))
+    return path
+
+
+@pytest.fixture(scope="module")
+def bare(home, wheels):
+    """The wheel alone: lptv with NumPy and SciPy, its only requirements."""
+    return _fresh_venv(home, wheels, "bare")
+
+
+@pytest.fixture(scope="module")
+def venv(home, wheels):
     """The wheel with the extras lptv demo uses: matplotlib (plots) and scikit-sundae (timedomain)."""
-    return _fresh_venv(tmp_path_factory, f"{wheel}[plots,timedomain]")
+    return _fresh_venv(home, wheels, "full", "[plots,timedomain]")
 
 
 def _installed_core(venv):
@@ -153,29 +227,32 @@ def hidden(show):
     return files
 
 
-def _run_hidden(argv, hidden, tmp_path, **kw):
-    """argv in a private mount namespace where every file of ``hidden`` is empty."""
+def _run_hidden(argv, hidden, home, cwd, **kw):
+    """argv as the unprivileged user in a private mount namespace where every file of ``hidden``
+    is empty (a user namespace maps the user to root there, which may bind-mount)."""
     if shutil.which("unshare") is None:
         pytest.skip("no unshare (util-linux) to hide the Debian libraries")
-    probe = subprocess.run(["unshare", "--mount", "--map-root-user", "true"], capture_output=True)
+    probe = _as_user(["unshare", "--mount", "--map-root-user", "true"], home)
     if probe.returncode != 0:
-        pytest.skip(f"unshare --mount --map-root-user is not allowed here: {probe.stderr.decode()[-300:]}")
-    empty = tmp_path / "empty"
+        pytest.skip(f"unshare --mount --map-root-user is not allowed here: {probe.stderr[-300:]}")
+    empty = home / "empty"
     empty.write_bytes(b"")
     script = ('e=$1; shift; while [ "$1" != -- ]; do mount --bind "$e" "$1" || exit 97; shift; done; '
               'shift; exec "$@"')
-    env = {k: v for k, v in os.environ.items() if k not in ("LD_LIBRARY_PATH", "LD_PRELOAD", "PYTHONPATH")}
-    env.update(MPLBACKEND="Agg", PATH="/usr/bin:/bin")
-    cmd = ["unshare", "--mount", "--map-root-user", "sh", "-c", script, "sh", str(empty), *hidden, "--",
-           *map(str, argv)]
-    return subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, env=env, **kw)
+    return _as_user(["unshare", "--mount", "--map-root-user", "sh", "-c", script, "sh", empty, *hidden,
+                     "--", *argv], home, cwd=cwd, **kw)
 
 
-def test_the_development_build_needs_the_hidden_libraries(hidden, tmp_path):
-    """The control: with the Debian libraries hidden, the module built against them cannot load."""
-    r = _run_hidden([sys.executable, "-c", "import lptv._core"], hidden, tmp_path)
+def test_the_development_build_needs_the_hidden_libraries(hidden, home, work):
+    """The control: the module built against the Debian libraries loads (dlopen) as the user,
+    and with them hidden it cannot."""
+    import lptv._core
+
+    load = [_interpreter(), "-c", "import ctypes, sys; ctypes.CDLL(sys.argv[1])", lptv._core.__file__]
+    _ok(_as_user(load, home, cwd=work))
+    r = _run_hidden(load, hidden, home, work)
     assert r.returncode not in (0, 97), r.stderr
-    assert "ImportError" in r.stderr and ("file too short" in r.stderr or "cannot open" in r.stderr), r.stderr
+    assert "file too short" in r.stderr or "cannot open" in r.stderr, r.stderr
 
 
 README_RUN = r'''
@@ -188,22 +265,25 @@ exec(compile(block, "README.md", "exec"), ns)
 import lptv, lptv._core
 maps = sorted({line.split()[-1] for line in open("/proc/self/maps") if ".so" in line})
 res = ns["res"]
-print(json.dumps({"lptv": lptv.__file__, "core": lptv._core.__file__, "maps": maps,
+uid_map = open("/proc/self/uid_map").read().split()    # inside, outside, count
+print(json.dumps({"lptv": lptv.__file__, "core": lptv._core.__file__, "maps": maps, "uid_map": uid_map,
                   "converged": bool(res.converged), "residue_ok": bool(res.residue_ok)}))
 '''
 
 
-def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(bare, hidden, tmp_path):
+def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(bare, hidden, home, work):
     """The README's first example in the venv that holds the wheel and NumPy and SciPy only."""
     venv = bare
-    script = tmp_path / "readme_example.py"
+    script = work / "readme_example.py"
     script.write_text(README_RUN)
-    r = _run_hidden([venv / "bin" / "python", script, ROOT / "README.md"], hidden, tmp_path, timeout=600)
+    r = _run_hidden([venv / "bin" / "python", script, ROOT / "README.md"], hidden, home, work, timeout=600)
     assert r.returncode == 0, r.stderr[-3000:]
     out = json.loads(r.stdout.strip().splitlines()[-1])
     assert out["converged"] and out["residue_ok"]
+    if os.geteuid() == 0:  # root inside the namespace is the unprivileged user outside it
+        assert out["uid_map"][:2] == ["0", str(UNPRIVILEGED)], out["uid_map"]
     assert Path(out["lptv"]).is_relative_to(venv) and Path(out["core"]).is_relative_to(venv)
-    assert (tmp_path / "model.json").exists()
+    assert (work / "model.json").exists()
     libs_dir = (Path(out["core"]).parent.parent / "lptv.libs").resolve()
     loaded = [Path(p).resolve() for p in out["maps"]]
     assert not set(map(str, loaded)) & set(hidden), "a hidden library was loaded"
@@ -214,17 +294,16 @@ def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(bar
             assert p.parent == libs_dir, p
 
 
-def test_lptv_demo_without_its_extras_names_them(bare, tmp_path):
-    r = subprocess.run([bare / "bin" / "lptv", "demo", "--out", tmp_path / "demo"], capture_output=True,
-                       text=True, cwd=tmp_path)
+def test_lptv_demo_without_its_extras_names_them(bare, home, work):
+    r = _as_user([bare / "bin" / "lptv", "demo", "--out", work / "demo"], home, cwd=work)
     assert r.returncode == 2 and "pip install 'lptv[plots]'" in r.stderr, r.stderr[-2000:]
     assert len(r.stderr.strip().splitlines()) == 1
 
 
-def test_lptv_demo_runs_from_the_wheel_with_the_debian_libraries_hidden(venv, hidden, tmp_path):
-    r = _run_hidden([venv / "bin" / "lptv", "demo", "--out", tmp_path / "demo"], hidden, tmp_path,
+def test_lptv_demo_runs_from_the_wheel_with_the_debian_libraries_hidden(venv, hidden, home, work):
+    r = _run_hidden([venv / "bin" / "lptv", "demo", "--out", work / "demo"], hidden, home, work,
                     timeout=600)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
     assert "done in" in r.stdout
     for name in ("report.html", "summary.json", "model_wgtls.json"):
-        assert (tmp_path / "demo" / name).stat().st_size > 0, name
+        assert (work / "demo" / name).stat().st_size > 0, name
