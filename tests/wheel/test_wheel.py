@@ -16,9 +16,9 @@ PIP_PINS). The checks:
   ``lptv demo`` (with the extras it uses: matplotlib, scikit-sundae) run with the Debian
   libraries hidden from the loader: in a private mount namespace (``unshare``, no root needed
   where user namespaces are allowed) an empty file is bound over every library the development
-  build takes from the system outside the policy. The development build then fails to import
-  (the hiding works); the installed wheel runs, and /proc/self/maps shows none of the hidden
-  files loaded.
+  build takes from the system outside the policy. The development build's module then fails
+  to load (the hiding works); the installed wheel runs, and /proc/self/maps shows the bundled
+  copies loaded and none of the hidden files.
 """
 import json
 import os
