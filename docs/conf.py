@@ -60,6 +60,7 @@ sphinx_gallery_conf = {
     "min_reported_time": 0,
     "write_computation_times": False,
     "reset_modules": ("matplotlib",),
+    "capture_repr": (),   # what an example prints shows, not the value of its last line
 }
 
 # The Markdown files of the source tree, read into the pages of the same name (each page in

@@ -28,7 +28,16 @@ print(res.verdict)
 # %%
 # Each record alone determines the parameters less well than both together; the high lines
 # alone leave the model nearly unidentifiable (the warning below).
+import matplotlib.pyplot as plt
+
+free = res.parameter_std > 0
+fig, ax = plt.subplots()
 for i, (u, y) in enumerate(records):
     one = lptv.identify(u, y, na=2, nb=1, ka=3, kb=3, w0=m.w0, lines=range(1, 244), method="sml")
-    print(f"record {i + 1} alone: median std {np.median(one.parameter_std[one.parameter_std > 0]):.2e}")
-print(f"both records:     median std {np.median(res.parameter_std[res.parameter_std > 0]):.2e}")
+    print(f"record {i + 1} alone: median std {np.median(one.parameter_std[free]):.2e}")
+    ax.semilogy(one.parameter_std[free], ".", label=f"record {i + 1} alone")
+print(f"both records:     median std {np.median(res.parameter_std[free]):.2e}")
+ax.semilogy(res.parameter_std[free], "k_", ms=10, label="both records")
+ax.set_xlabel("parameter (eta_names order)")
+ax.set_ylabel("standard deviation")
+ax.legend()

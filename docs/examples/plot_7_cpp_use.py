@@ -99,3 +99,11 @@ eta_cpp = np.array([float(line.split()[1]) for line in lines[1:]])
 print("parameters:", eta_cpp.size, " largest difference C++ - Python:", np.abs(eta_cpp - res.eta).max())
 assert np.allclose(eta_cpp, res.eta, rtol=1e-9, atol=1e-12)
 shutil.rmtree(work)
+
+import matplotlib.pyplot as plt
+
+fig, ax = plt.subplots()
+ax.plot(res.eta, eta_cpp, "o", mfc="none")
+ax.plot([res.eta.min(), res.eta.max()], [res.eta.min(), res.eta.max()], "k-", lw=0.6)
+ax.set_xlabel("parameter from lptv.identify (Python)")
+ax.set_ylabel("parameter from lptv::identify (C++)")
