@@ -1,6 +1,7 @@
 # One entry point for users and CI. Each target installs what it needs and is
 # idempotent: a second run only rebuilds what changed.
-#   make test   - install, build, run the C++ tests (ctest), the CMake consumer and pytest
+#   make test   - install, build, run the C++ tests (ctest), the CMake consumer, pytest, then make
+#                 wheel and make docs
 #   make demo   - install and run the main job (lptv demo)
 #   make bench  - install (with SUNDIALS), build and run the benchmarks
 #   make stubs  - regenerate python/lptv/_core.pyi after a change of the bindings
