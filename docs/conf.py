@@ -8,7 +8,11 @@ import os
 import re
 from pathlib import Path
 
+from sphinx.util import logging
+
 import lptv
+
+logger = logging.getLogger(__name__)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -132,6 +136,17 @@ def _plain_bars(app, what, name, obj, options, lines):
             lines[i] = "".join(p if p.startswith("``") else p.replace("|", "\\|") for p in parts)
 
 
+def _api_covers_all(app):
+    """Every public name of the package (lptv.__all__) has its entry in api.rst: a new function
+    that is not documented there is a warning, so make docs (-W) fails."""
+    text = (Path(app.srcdir) / "api.rst").read_text()
+    documented = set(re.findall(r"^\.\. auto(?:function|class|exception|data):: (?:lptv\.)?(\w+)\s*$",
+                                text, flags=re.M))
+    for name in sorted(set(lptv.__all__) - documented):
+        logger.warning(f"api.rst does not document lptv.{name} (it is in lptv.__all__)")
+
+
 def setup(app):
+    app.connect("builder-inited", _api_covers_all)
     app.connect("source-read", _markdown_page)
     app.connect("autodoc-process-docstring", _plain_bars)
