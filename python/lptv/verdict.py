@@ -52,6 +52,9 @@ class ResidueTest:
     """One-sided (upper) for an offset group, two-sided for all judged rows."""
     p_holm: float
     """Holm-adjusted p-value (reject when below ``ALPHA``)."""
+    kind: str = "residues"
+    """'residues' (a sum of normal scores) or 'score' (the score test for one more harmonic on
+    one coefficient: ``statistic`` is then its F value)."""
 
     @property
     def rejects(self) -> bool:
@@ -80,6 +83,10 @@ class ResidueTests:
     def sentences(self) -> Tuple[str, ...]:
         out = []
         for t in self.rejected:
+            if t.kind == "score":
+                out.append(f"{t.name} would fit the residues better (F = {t.statistic:.2f}, p = "
+                           f"{t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} < {self.alpha:g})")
+                continue
             side = "too large" if t.statistic > 0 else "too small"
             out.append(f"the normalised residues on the {t.rows.size} {t.name} are {side} "
                        f"(z = {t.statistic:.2f}, p = {t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} "
@@ -132,6 +139,8 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     theta = np.asarray(res.theta)
     # Per experiment: its rows in sorted order, S (interleaved), the real Jacobian.
     order, S_blocks, J_blocks, nus, signal_rows, offsets = [], [], [], [], [], []
+    extensions = _extensions(structure, par)
+    score_parts = {x: [] for x in extensions}    # per experiment: (s, F, Jf, Sdiag, P)
     for e, d in enumerate(datas):
         idx = np.flatnonzero(experiment == e)
         if idx.size == 0:
@@ -155,6 +164,10 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         signal_rows.append(np.ones(srt.size, bool))
         ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
         offsets.append(_offset_groups(srt, ex))
+        for x, par_x in extensions.items():
+            part = _score_part(d, par_x, srt, res.model)
+            if part is not None:
+                score_parts[x].append(part + (P,))
     if not order:
         return None
     order = np.concatenate(order)
@@ -211,6 +224,13 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         if mask.any() and not np.array_equal(mask, judged):
             t = stat(mask)
             tests.append((f"rows {g} line{'' if g == 1 else 's'} from the nearest excited line", mask, t, float(stats.norm.sf(t))))
+    kinds = ["residues"] * len(tests)
+    # Score tests: one more harmonic on each coefficient (METHOD.md section 7).
+    for x, parts in score_parts.items():
+        out = _score_test(parts, extensions[x], x)
+        if out is not None:
+            tests.append((f"one more harmonic on {x}", judged, out[0], out[1]))
+            kinds.append("score")
     # Holm's step-down adjustment.
     p = np.array([t[3] for t in tests])
     k = p.size
@@ -221,7 +241,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         run = max(run, min(1.0, (k - rank) * p[i]))
         adj[i] = run
     out_tests = tuple(ResidueTest(name=t[0], rows=np.sort(lines[order[t[1]]]), statistic=t[2], p_value=t[3],
-                                  p_holm=float(adj[i])) for i, t in enumerate(tests))
+                                  p_holm=float(adj[i]), kind=kinds[i]) for i, t in enumerate(tests))
     judged_all = np.zeros(lines.size, bool)
     judged_all[order] = judged
     score_all = np.full(lines.size, np.nan)
@@ -229,6 +249,100 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     lev_all = np.full(lines.size, np.nan)
     lev_all[order] = 1.0 - shrink
     return ResidueTests(tests=out_tests, judged=judged_all, score=score_all, leverage=lev_all)
+
+
+def _extensions(structure, par) -> dict:
+    """{'a0': the Parametrisation with one more harmonic on a_0, ...} for every coefficient of
+    a structure without known coefficients ({} otherwise)."""
+    if par.has_known:
+        return {}
+    out = {}
+    na, nb = structure.na, structure.nb
+    for is_a, n_max in ((True, na), (False, nb)):
+        for order in range(n_max + 1):
+            ka, kb = list(structure.ka), list(structure.kb)
+            (ka if is_a else kb)[order] += 1
+            out[f"{'a' if is_a else 'b'}{order}"] = _core.Parametrisation(na, nb, ka, kb, [], structure.w0,
+                                                                           structure.ts)
+    return out
+
+
+def _extra_names(par_x, name):
+    """Indices in xi of Re and Im of the extra (highest) harmonic of coefficient ``name``."""
+    names = list(par_x.eta_names)
+    order = int(name[1:])
+    s = par_x.structure
+    K = (s.ka if name[0] == "a" else s.kb)[order]
+    return [names.index(f"{name}.re{K}"), names.index(f"{name}.im{K}")]
+
+
+def _score_part(d, par_x, rows, model):
+    """One experiment's share of the score test for the extension par_x at the fitted model
+    (the extra harmonic zero): s = J^T S^-1 r and F = J^T S^-1 J over the free entries of xi,
+    the real Jacobian over them and the residue variances (for the degrees of freedom); rows
+    whose lines +-K' leave the data are left out. None when nothing is left."""
+    K = par_x.structure.kmax
+    ok = [int(l) for l in rows if l + K <= d.max_line]
+    if len(ok) < 2:
+        return None
+    try:
+        theta_x = np.asarray(par_x.theta_from_model(model._cpp))
+        like = _core.ExactLikelihood(d._cpp, par_x, ok)
+        free = list(par_x.free_indices)
+        s = np.asarray(like.gradient(theta_x))[free] / 2.0
+        F = np.asarray(like.fisher_information(theta_x))
+        srt = [int(l) for l in like.sorted_rows]
+        J = np.asarray(_core.jacobian(d._cpp, par_x, srt)) @ np.asarray(par_x.Text)
+        Jr = np.empty((2 * J.shape[0], J.shape[1]))
+        Jr[0::2], Jr[1::2] = J.real, J.imag
+        Sd = np.diag(np.asarray(like.residue_covariance(theta_x)))
+    except (_core.NumericalError, ValueError):
+        return None
+    return s, F, Jr[:, free], Sd
+
+
+def _score_test(parts, par_x, name):
+    """Neyman's C(alpha) form of the score test for the extra harmonic of coefficient ``name``
+    (two real parameters) from the experiments' parts: the efficient score
+    s_e - F_et F_tt^-1 s_t with covariance F_ee - F_et F_tt^-1 F_te (valid at any root-n
+    consistent fit of the restricted model, WGTLS as well as SML), its quadratic form LM
+    divided by the small-sample factor (P-2)/(P-3) of noise (co)variances estimated from P
+    periods (METHOD.md section 10), against 2 F(2, nu) with nu the rows' Satterthwaite degrees
+    of freedom. Returns (F value, p-value), or None (2 or 3 periods, nothing to test)."""
+    from scipy import stats
+
+    if not parts:
+        return None
+    Ps = [p[4] for p in parts]
+    if any(2 <= P < 4 for P in Ps):
+        return None
+    s = sum(p[0] for p in parts)
+    F = sum(p[1] for p in parts)
+    free = list(par_x.free_indices)
+    e = [free.index(i) for i in _extra_names(par_x, name)]
+    t = [j for j in range(len(free)) if j not in e]
+    try:
+        X = np.linalg.solve(F[np.ix_(t, t)], F[np.ix_(t, e)])
+        se = s[e] - X.T @ s[t]
+        Ve = F[np.ix_(e, e)] - F[np.ix_(e, t)] @ X
+        LM = float(se @ np.linalg.solve(Ve, se))
+    except np.linalg.LinAlgError:
+        return None
+    P = min(Ps)
+    kappa = (P - 2) / (P - 3) if P >= 4 else 1.0
+    c_all, nu_all = [], []
+    for (_, _, Jf, Sd, Pe) in parts:
+        Jp = Jf[:, e] - Jf[:, t] @ X
+        c = (Jp**2).sum(axis=1) / Sd
+        c_all.append(c[0::2] + c[1::2])
+        nu_all.append(np.full(c.size // 2, 2.0 * (Pe - 1) if Pe >= 2 else np.inf))
+    c, nu = np.concatenate(c_all), np.concatenate(nu_all)
+    fin = np.isfinite(nu) & (c > 0)
+    Fval = LM / (2.0 * kappa)
+    if fin.any():
+        nu_eff = c.sum() ** 2 / np.sum(c[fin] ** 2 / nu[fin])
+        return Fval, float(stats.f.sf(Fval, 2, nu_eff))
+    return Fval, float(stats.chi2.sf(LM, 2))
 
 
 def _offset_groups(rows: np.ndarray, excited: np.ndarray) -> np.ndarray:

@@ -67,13 +67,20 @@ def test_group_statistics_are_standard_normal_without_a_model_error(system):
     statistic has mean 0 and standard deviation 1 within its sampling error (mean: 1/sqrt(40)
     = 0.16, std: about 1/sqrt(80) = 0.11; bounds at 3.5 of them, a little wider below 1 where
     the tests are conservative by construction (shared lines ignored))."""
-    stats = []
+    stats, scores = [], []
     for seed in range(40):
         d = system_measurements(system, seed=seed + 500, periods=4)
-        stats.append([t.statistic for t in _fit(d, "sml").residue_tests.tests])
+        tests = _fit(d, "sml").residue_tests.tests
+        stats.append([t.statistic for t in tests if t.kind == "residues"])
+        scores.append([t.statistic for t in tests if t.kind == "score"])
     T = np.array(stats)
     assert np.all(np.abs(T.mean(axis=0)) < 3.5 * 0.16), T.mean(axis=0)
     assert np.all((T.std(axis=0) > 0.55) & (T.std(axis=0) < 1.0 + 3.5 * 0.11)), T.std(axis=0)
+    # the score tests' F values (one more harmonic per coefficient): F(2, nu) with nu large has
+    # mean 1 and standard deviation 1, so the mean of 40 lies within 1 +- 3.5 / sqrt(40)
+    F = np.array(scores)
+    assert F.shape[1] == len(d["structure"]["ka"]) + len(d["structure"]["kb"])
+    assert np.all(np.abs(F.mean(axis=0) - 1.0) < 3.5 / np.sqrt(40)), F.mean(axis=0)
 
 
 def test_leverage_sums_to_half_the_parameters_for_an_lti_model():
@@ -152,3 +159,22 @@ def test_undecided_stability_is_reported_not_swallowed():
                             known={"a2": [0.6, 1.0, 0.6]})    # a_2(t) = 1 + 1.2 cos: a zero
     assert res.unstable is None and "not decided" in res.stability_undecided
     assert res.stability_undecided in res.summary()
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_score_test_sees_a_missing_harmonic_on_the_discrete_system(seed):
+    """The discrete-time system with one more harmonic on a_0 (2 % of its mean, 0.01 on 0.5),
+    P = 8: the residue groups rejected it in about half the realisations; the score test for one
+    more harmonic on a_0 (METHOD.md section 7) rejects it, and the same test keeps the true
+    structure of the same noise."""
+    d = system_measurements("discrete", seed=seed + 40, periods=8)
+    m = _with_extra_harmonic(d["model"])
+    y0 = lptv.time_signal(lptv.simulate(m, d["U0"]), d["u0"].size)
+    u, y = noisy_periods(d["u0"], y0, 8, seed=seed + 140, **d["noise"])
+    res = _fit(dict(d, u=u, y=y), "sml")
+    assert not res.model_ok
+    rejected = [t.name for t in res.residue_tests.rejected]
+    assert "one more harmonic on a0" in rejected, rejected
+    assert any("one more harmonic on a0 would fit" in s for s in res.residue_tests.sentences())
+    u0, y0t = noisy_periods(d["u0"], d["y0"], 8, seed=seed + 140, **d["noise"])
+    assert _fit(dict(d, u=u0, y=y0t), "sml").model_ok
