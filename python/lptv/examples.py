@@ -300,7 +300,9 @@ def discrete_model() -> Model:
     (K = 2), a1 (K = 1) and b0 (K = 2) (``DISCRETE_STRUCTURE``).
 
     Mean system (0.5 z + 1) / (z^2 - 1.2 z + 0.5) (poles at |z| = 0.71), excited every 6th line
-    (``DISCRETE_EXCITED``). Every frozen system is stable and so is the periodic one.
+    (``DISCRETE_EXCITED``). The periodic system is stable (Floquet multipliers below 1e-25 per
+    period), though the frozen systems are not over part of the period (a frozen pole reaches 1.13
+    near t = 142): frozen poles say nothing of stability (METHOD.md section 12).
 
     Examples
     --------
