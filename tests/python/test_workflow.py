@@ -141,7 +141,14 @@ def test_the_wrong_model_is_rejected_whatever_the_fraction_on_all_lines(record, 
     rc, out, err = run_cli(capsys, src, "--na", 2, "--nb", 0, "--periods", 8, "--ts", 0.01, "--out", tmp_path / "o")
     assert rc == 0 and "verdict: MODEL ERRORS: the model is rejected" in out
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
-    assert s["model_ok"] is False and len(s["model_errors"]) == 3
+    assert s["model_ok"] is False
+    errors = s["model_errors"]
+    # the residues, the cost and the prediction; and the score tests: any freedom fits the
+    # residues of a wrong structure better
+    assert any("rows with signal are too large" in e for e in errors)
+    assert any("far above its noise level" in e for e in errors)
+    assert any("misses the measured output" in e for e in errors)
+    assert any(e.startswith("one more harmonic on a0") for e in errors)
 
 
 def test_excited_lines_of_an_lptv_model_reach_plus_minus_k(record):
