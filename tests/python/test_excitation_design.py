@@ -36,6 +36,7 @@ def test_schroeder_phases_closed_form_and_general(seed, tol):
     (128, 1, np.arange(1, 51)),
     (100, 3, np.array([0, 3, 7, 10, 17, 50])),    # DC and the Nyquist line of N on a finer grid
     (64, 1, np.array([0, 5, 9, 32])),             # the grid's own Nyquist line
+    (63, 3, np.arange(1, 21)),                    # an odd grid (the FFT's odd-length path)
 ])
 @pytest.mark.parametrize("p", [4, 16, 256])
 def test_objective_and_gradient_against_direct_sums(N, oversample, lines, p, seed):
