@@ -164,8 +164,9 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         signal_rows.append(np.ones(srt.size, bool))
         ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
         offsets.append(_offset_groups(srt, ex))
+        sdiag = np.diag(S_blocks[-1]).copy()
         for x, par_x in extensions.items():
-            part = _score_part(d, par_x, srt, res.model)
+            part = _score_part(d, par_x, srt, res.model, sdiag)
             if part is not None:
                 score_parts[x].append(part + (P,))
     if not order:
@@ -276,13 +277,17 @@ def _extra_names(par_x, name):
     return [names.index(f"{name}.re{K}"), names.index(f"{name}.im{K}")]
 
 
-def _score_part(d, par_x, rows, model):
+def _score_part(d, par_x, rows, model, sdiag):
     """One experiment's share of the score test for the extension par_x at the fitted model
     (the extra harmonic zero): s = J^T S^-1 r and F = J^T S^-1 J over the free entries of xi,
     the real Jacobian over them and the residue variances (for the degrees of freedom); rows
-    whose lines +-K' leave the data are left out. None when nothing is left."""
+    whose lines +-K' leave the data are left out. None when nothing is left. ``rows`` are sorted
+    and ``sdiag`` is the diagonal of the fit's residue covariance on them (interleaved Re, Im):
+    with the extra harmonic zero the extended structure's residues are the fit's, and so is
+    their covariance."""
     K = par_x.structure.kmax
-    ok = [int(l) for l in rows if l + K <= d.max_line]
+    keep = np.asarray(rows) + K <= d.max_line
+    ok = [int(l) for l in np.asarray(rows)[keep]]
     if len(ok) < 2:
         return None
     try:
@@ -295,7 +300,7 @@ def _score_part(d, par_x, rows, model):
         J = np.asarray(_core.jacobian(d._cpp, par_x, srt)) @ np.asarray(par_x.Text)
         Jr = np.empty((2 * J.shape[0], J.shape[1]))
         Jr[0::2], Jr[1::2] = J.real, J.imag
-        Sd = np.diag(np.asarray(like.residue_covariance(theta_x)))
+        Sd = sdiag[np.repeat(keep, 2)]
     except (_core.NumericalError, ValueError):
         return None
     return s, F, Jr[:, free], Sd
