@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from . import _core
-from ._validate import as_int, as_real_1d
+from ._validate import as_counts, as_int, as_real_1d
 from .fds import simulate
 from .model import Model
 
@@ -79,7 +79,7 @@ def _record_periods(n_total, n0, name):
 class _Grid:
     """The record's DFT grid and the band operators of a coefficient set on it."""
 
-    def __init__(self, N, L, w0, ts):
+    def __init__(self, N, L):
         self.N, self.L = N, L
         self.x = np.exp(2j * np.pi * np.arange(N) / N)          # z_m (discrete time)
 
@@ -216,12 +216,7 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
     L = _record_periods(N, n0, "u")
     na = as_int(na, "na", minimum=1, maximum=50)
     nb = as_int(nb, "nb", minimum=0, maximum=50)
-    ka_l = [as_int(ka, "ka", maximum=10**4)] * (na + 1) if np.ndim(ka) == 0 else [as_int(k, "ka", maximum=10**4) for k in ka]
-    kb_l = [as_int(kb, "kb", maximum=10**4)] * (nb + 1) if np.ndim(kb) == 0 else [as_int(k, "kb", maximum=10**4) for k in kb]
-    if len(ka_l) != na + 1:
-        raise ValueError(f"ka must have na + 1 = {na + 1} entries, got {len(ka_l)}")
-    if len(kb_l) != nb + 1:
-        raise ValueError(f"kb must have nb + 1 = {nb + 1} entries, got {len(kb_l)}")
+    ka_l, kb_l = as_counts(ka, na, "ka"), as_counts(kb, nb, "kb")
     max_iterations = as_int(max_iterations, "max_iterations", minimum=1, maximum=10**5)
     lpm_degree = as_int(lpm_degree, "lpm_degree", maximum=6)
     par = _core.Parametrisation(na, nb, ka_l, kb_l, [], float(w0), 0.0 if ts is None else float(ts))
@@ -234,7 +229,7 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         if lines.min() < 1 or lines.max() > N // 2 - 1:
             raise ValueError(f"lines must lie in 1..{N // 2 - 1} (the record's grid), got "
                              f"{lines.min()}..{lines.max()}")
-    grid = _Grid(N, L, float(w0), float(ts))
+    grid = _Grid(N, L)
     U = np.fft.fft(u) / N
     Y = np.fft.fft(y) / N
     kmax = max(ka_l + kb_l)
@@ -315,8 +310,7 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
 
     def solve(a, R):
         """A^-1 R on the record's grid (R: full arrays, columns), by the core's FDS."""
-        R1 = one(R)
-        R1 = R1.copy()
+        R1 = one(R).copy()
         R1[0] = R1[0].real
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

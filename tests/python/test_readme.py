@@ -5,6 +5,16 @@ from pathlib import Path
 README = Path(__file__).resolve().parents[2] / "README.md"
 
 
+def run_block(marker, tmp_path, monkeypatch):
+    """Runs the one Python block of the README that contains ``marker``, in tmp_path; its names."""
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S) if marker in b]
+    assert len(blocks) == 1
+    monkeypatch.chdir(tmp_path)
+    ns = {}
+    exec(compile(blocks[0], "README.md", "exec"), ns)
+    return ns
+
+
 def test_readme_python_example_runs(tmp_path, monkeypatch):
     blocks = re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
     assert blocks, "README has no Python example"
@@ -20,12 +30,7 @@ def test_readme_python_example_runs(tmp_path, monkeypatch):
 
 def test_readme_batch_example_runs(tmp_path, monkeypatch):
     """The Monte Carlo and batch example (on local processes, as printed)."""
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-              if "lptv.montecarlo(" in b]
-    assert len(blocks) == 1
-    monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = run_block("lptv.montecarlo(", tmp_path, monkeypatch)
     mc, summary, table = ns["mc"], ns["summary"], ns["table"]
     assert mc.runs == 100 and mc.methods == ("wgtls", "sml") and mc.executor.endswith("processes")
     assert (mc.overview().failures == 0).all()
@@ -42,12 +47,7 @@ def test_readme_several_experiments_example_runs(tmp_path, monkeypatch):
     import lptv
     from lptv.examples import paper_model
 
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-              if "records.append(" in b]
-    assert len(blocks) == 1
-    monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = run_block("records.append(", tmp_path, monkeypatch)
     res = ns["res"]
     assert res.n_experiments == 2 and np.array_equal(np.bincount(res.experiment), [243, 243])
     assert res.converged and res.model_ok
@@ -62,12 +62,7 @@ def test_readme_real_rig_example_runs(tmp_path, monkeypatch):
     estimated, and the fit weighted by noise and distortion is near its noise level."""
     import numpy as np
 
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-              if "lptv.distortion(" in b]
-    assert len(blocks) == 1
-    monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = run_block("lptv.distortion(", tmp_path, monkeypatch)
     d, bla = ns["d"], ns["bla"]
     assert d.detected and ns["ax"].get_ylabel() == "power (dB)"
     assert np.isfinite(ns["G"][d.branches]).all()            # branch 0 at every excited line
@@ -78,12 +73,7 @@ def test_readme_excitation_design_example_runs(tmp_path, monkeypatch):
     """The design example: the printed lines and crest factors are what the code gives."""
     import numpy as np
 
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-              if "lptv.min_crest_multisine(" in b]
-    assert len(blocks) == 1
-    monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = run_block("lptv.min_crest_multisine(", tmp_path, monkeypatch)
     d, design = ns["d"], ns["design"]
     assert d.excited[:4].tolist() == [5, 25, 45, 65] and d.odd_detection[:3].tolist() == [15, 35, 55]
     assert design.crest_factor < design.initial_crest_factor
@@ -94,12 +84,7 @@ def test_readme_excitation_design_example_runs(tmp_path, monkeypatch):
 
 def test_readme_single_record_example_runs(tmp_path, monkeypatch):
     """One record: the fit with the transient is near its noise level, the one without is not."""
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-              if "lptv.identify_record(" in b]
-    assert len(blocks) == 1
-    monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = run_block("lptv.identify_record(", tmp_path, monkeypatch)
     res, steady = ns["res"], ns["steady"]
     assert res.periods == 4 and res.converged and 0.8 < res.cost_ratio < 1.2
     assert steady.cost_ratio > 5

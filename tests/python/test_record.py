@@ -129,7 +129,7 @@ def test_noise_given_or_by_the_local_polynomial_method():
     (dict(lines=[0, 5]), "lines must lie in"),
     (dict(lines=[1, 2]), "lines: 2 lines give 4 real equations"),
     (dict(na=0), "na must be"),
-    (dict(ka=[1, 1]), "ka must have"),
+    (dict(ka=[1, 1]), "ka must give one harmonic count per coefficient"),
 ])
 def test_bad_input(kwargs, match):
     m = discrete_model()
