@@ -19,6 +19,9 @@ void dgesvd_(const char* jobu, const char* jobvt, const int* m, const int* n, do
 // LAPACK: QR of a triangular-pentagonal pair [A; B] (A upper triangular n x n).
 void dtpqrt_(const int* m, const int* n, const int* l, const int* nb, double* a, const int* lda,
              double* b, const int* ldb, double* t, const int* ldt, double* work, int* info);
+// LAPACK: QR of a general matrix.
+void dgeqrf_(const int* m, const int* n, double* a, const int* lda, double* tau, double* work, const int* lwork,
+             int* info);
 }
 
 namespace lptv {
@@ -144,9 +147,54 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> smallest_singular_vector(Eigen::Matr
   return {s.reverse(), vt.row(n - 1).transpose()};
 }
 
+// The singular values of a square M, ascending (dgesvd without vectors: a third of the cost
+// with them at 35 columns).
+Eigen::VectorXd singular_values_of(Eigen::MatrixXd M) {
+  const int n = static_cast<int>(M.cols()), one = 1;
+  Eigen::VectorXd s(n);
+  double u = 0, vt = 0, query = 0;
+  int info = 0, lwork = -1;
+  dgesvd_("N", "N", &n, &n, M.data(), &n, s.data(), &u, &one, &vt, &one, &query, &lwork, &info);
+  lwork = static_cast<int>(query);
+  std::vector<double> work(static_cast<size_t>(std::max(lwork, 1)));
+  dgesvd_("N", "N", &n, &n, M.data(), &n, s.data(), &u, &one, &vt, &one, work.data(), &lwork, &info);
+  if (info != 0) throw NumericalError("SVD (dgesvd) failed: info " + std::to_string(info));
+  return s.reverse();
+}
+
+// The right singular vector of the smallest singular value of an upper-triangular M by inverse
+// iteration, v <- (M^T M)^{-1} v through two triangular solves (2 n^2 flops a step against
+// ~20 n^3 for dgesvd's vectors), from `start`. Each step shrinks the other directions by
+// (sigma_1 / sigma_2)^2, so it is taken only when sigma_2 >= 2 sigma_1 (a factor <= 1/4 a
+// step) and it stops when a step changes v by less than 8 eps, or when the change stops
+// shrinking at rounding level; an empty result (no convergence in 60 steps) sends the caller
+// to dgesvd. The triangular solves are backward stable, so the converged v is the singular
+// vector to the accuracy dgesvd gives it (eps ||M|| / (sigma_2 - sigma_1)).
+Eigen::VectorXd inverse_iteration(const Eigen::MatrixXd& M, Eigen::VectorXd v) {
+  const auto U = M.triangularView<Eigen::Upper>();
+  double nv = v.norm();
+  if (!(nv > 0) || !v.allFinite()) return {};
+  v /= nv;
+  double prev = std::numeric_limits<double>::infinity();
+  for (int it = 0; it < 60; ++it) {
+    Eigen::VectorXd z = U.transpose().solve(v);
+    U.solveInPlace(z);
+    const double nz = z.norm();
+    if (!(nz > 0) || !std::isfinite(nz)) return {};
+    z /= nz;
+    if (z.dot(v) < 0) z = -z;
+    const double change = (z - v).norm();
+    v = z;
+    if (change < 8 * std::numeric_limits<double>::epsilon()) return v;
+    if (it >= 3 && change < 1e-12 && change > 0.5 * prev) return v;  // at rounding level
+    prev = change;
+  }
+  return {};
+}
+
 }  // namespace
 
-GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
+GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ, const Eigen::VectorXd& start) {
   const Eigen::Index n = R.cols();
   Eigen::VectorXd scale(n);
   for (Eigen::Index j = 0; j < n; ++j) {
@@ -168,7 +216,22 @@ GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
     const double ratio = dl.minCoeff() / dl.maxCoeff();
     if (ratio * ratio > 1e-8) {
       // M = Rs L^{-T}: solve L M^T = Rs^T.
+      // M is upper triangular (Rs and L^{-T} are). With a start (the previous WGTLS solve's
+      // x, so v0 = L^T x / scale) and a gap, its smallest right singular vector is had by
+      // inverse iteration and only the values by dgesvd.
       const Eigen::MatrixXd M = llt.matrixL().solve(Rs.transpose()).transpose();
+      if (start.size() == n) {
+        const Eigen::VectorXd sv = singular_values_of(M);
+        if (n >= 2 && sv[1] >= 2.0 * sv[0]) {
+          const Eigen::VectorXd v0 = llt.matrixU() * (start.array() / scale.array()).matrix();
+          const Eigen::VectorXd v = inverse_iteration(M, v0);
+          if (v.size() == n) {
+            out.values = sv;
+            out.x = scale.asDiagonal() * llt.matrixU().solve(v);
+            return out;
+          }
+        }
+      }
       const auto [sv, v] = smallest_singular_vector(M);
       out.values = sv;
       out.x = scale.asDiagonal() * llt.matrixU().solve(v);
@@ -224,8 +287,9 @@ Solved solve_ls(const Eigen::MatrixXd& R, int norm_index) {
   return s;
 }
 
-Solved solve_gtls(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ) {
-  GtlsSolve g = gtls_from_r(R, CJ);
+Solved solve_gtls(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ,
+                  const Eigen::VectorXd& start = Eigen::VectorXd()) {
+  GtlsSolve g = gtls_from_r(R, CJ, start);
   return {g.x, g.values, g.values[0] * g.values[0]};
 }
 
@@ -240,25 +304,172 @@ struct Experiments {
   size_t size() const { return d.size(); }
 };
 
+// One experiment's rows as WGTLS visits them at every iteration: the residue variance for
+// theta, the R factor of the weighted real Jacobian and CJ_W for weights w. The Jacobian does
+// not depend on theta and C_l (METHOD.md section 6) not on the weights, so below
+// kCacheRows rows (and 64 MB) both are built once: the real Jacobian J (2m x n, rows Re, Im
+// of each line) and, per row, the entries of C_l that can be nonzero (pairs of parameters of
+// one harmonic k: ne = sum_k |group_k|^2). Then an iteration is
+//   var e_l = Re sum_e C_l[e] conj(theta_a) theta_b   (one gemv over the cached entries),
+//   C = sum_l w_l C_l                                  (one gemv),
+//   CJ_W = Re(Text^H C Text)                           (Text's nonzeros, listed once),
+//   R = qr(diag(sqrt w) J)                             (LAPACK's dgeqrf),
+// the same arithmetic as the functions above (which build it row by row) in another order.
+// Larger problems use those functions (two threads, O(block) memory).
+class WeightedRows {
+ public:
+  static constexpr size_t kCacheRows = 20000;  // where parallel_rows starts splitting
+  static constexpr size_t kCacheBytes = size_t(64) << 20;
+
+  WeightedRows(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows)
+      : d_(d), p_(p), rows_(rows) {
+    const int K = p.structure().kmax();
+    std::vector<std::vector<int>> by_k(2 * K + 1);
+    for (int q = 0; q < p.n_theta(); ++q) by_k[K + p.params()[q].k].push_back(q);
+    size_t ne = 0;
+    for (const auto& g : by_k) ne += g.size() * g.size();
+    const size_t m = rows.size(), n = static_cast<size_t>(p.n_xi());
+    const size_t bytes = m * (2 * n * sizeof(double) + ne * sizeof(cd));
+    if (m == 0 || m >= kCacheRows || bytes > kCacheBytes) return;
+    cached_ = true;
+    for (int k = -K; k <= K; ++k)
+      for (int a : by_k[K + k])
+        for (int b : by_k[K + k]) pairs_.push_back({a, b});
+    // CJ(i, j) += Re(conj(T(a, i)) T(b, j) C(a, b)) for every listed entry (a, b).
+    const Eigen::MatrixXcd& T = p.Text();
+    std::vector<std::vector<std::pair<int, cd>>> trow(static_cast<size_t>(p.n_theta()));
+    for (int c = 0; c < T.cols(); ++c)
+      for (int q = 0; q < T.rows(); ++q)
+        if (T(q, c) != cd(0.0, 0.0)) trow[static_cast<size_t>(q)].push_back({c, T(q, c)});
+    for (size_t e = 0; e < pairs_.size(); ++e)
+      for (const auto& [i, ti] : trow[static_cast<size_t>(pairs_[e].first)])
+        for (const auto& [j, tj] : trow[static_cast<size_t>(pairs_[e].second)])
+          to_cj_.push_back({static_cast<int>(e), i, j, std::conj(ti) * tj});
+    const auto entries = text_entries(p);
+    const detail::Lines X{d};
+    detail::RowPowers pw(p.structure());
+    std::vector<cd> jrow(static_cast<size_t>(p.n_theta()));
+    Eigen::VectorXcd xrow(static_cast<Eigen::Index>(n));
+    J_.resize(static_cast<Eigen::Index>(2 * m), static_cast<Eigen::Index>(n));
+    C_.resize(static_cast<Eigen::Index>(ne), static_cast<Eigen::Index>(m));
+    std::vector<cd> f;
+    for (size_t r = 0; r < m; ++r) {
+      const int l = rows[r];
+      pw.compute(l);
+      detail::jacobian_row(p, X, pw, l, jrow.data());
+      xrow.setZero();
+      for (const auto& e : entries) xrow[e.c] += jrow[static_cast<size_t>(e.p)] * e.v;
+      J_.row(static_cast<Eigen::Index>(2 * r)) = xrow.real().transpose();
+      J_.row(static_cast<Eigen::Index>(2 * r + 1)) = xrow.imag().transpose();
+      Eigen::Index e = 0;
+      for (int k = -K; k <= K; ++k) {
+        const auto& group = by_k[K + k];
+        const int i = l - k;
+        const double vy = X.varY(i), vu = X.varU(i);
+        const cd cyu = X.covYU(i);
+        f.resize(group.size());
+        for (size_t a = 0; a < group.size(); ++a) {
+          const Param& pr = p.params()[static_cast<size_t>(group[a])];
+          f[a] = (pr.is_a ? 1.0 : -1.0) * pw(k, pr.order);
+        }
+        for (size_t a = 0; a < group.size(); ++a) {
+          const bool ya = p.params()[static_cast<size_t>(group[a])].is_a;
+          for (size_t b = 0; b < group.size(); ++b) {
+            const bool yb = p.params()[static_cast<size_t>(group[b])].is_a;
+            const cd x = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
+            C_(e++, static_cast<Eigen::Index>(r)) = std::conj(f[a]) * f[b] * x;
+          }
+        }
+      }
+    }
+    B_.resize(J_.rows(), J_.cols());
+    tau_.resize(J_.cols());
+    int mm = static_cast<int>(J_.rows()), nn = static_cast<int>(J_.cols()), lwork = -1, info = 0;
+    double query = 0;
+    dgeqrf_(&mm, &nn, B_.data(), &mm, tau_.data(), &query, &lwork, &info);
+    work_.resize(static_cast<size_t>(std::max(1, static_cast<int>(query))));
+  }
+
+  Eigen::VectorXd variance(const Eigen::VectorXcd& theta) const {
+    if (!cached_) return residue_variance(d_, p_, rows_, theta);
+    Eigen::VectorXcd z(static_cast<Eigen::Index>(pairs_.size()));
+    for (size_t e = 0; e < pairs_.size(); ++e) z[static_cast<Eigen::Index>(e)] = std::conj(theta[pairs_[e].first]) * theta[pairs_[e].second];
+    // Re(C^T z) = Cr^T zr - Ci^T zi: C as real (2 ne x m), z as (zr, -zi) interleaved.
+    const Eigen::Map<const Eigen::MatrixXd> Cr(reinterpret_cast<const double*>(C_.data()), 2 * C_.rows(), C_.cols());
+    Eigen::VectorXd zz(2 * z.size());
+    for (Eigen::Index e = 0; e < z.size(); ++e) {
+      zz[2 * e] = z[e].real();
+      zz[2 * e + 1] = -z[e].imag();
+    }
+    return Cr.transpose() * zz;
+  }
+
+  Eigen::MatrixXd r_factor(const Eigen::VectorXd& w) const {
+    if (!cached_) return weighted_r_factor(d_, p_, rows_, w);
+    const Eigen::Index m = static_cast<Eigen::Index>(rows_.size()), n = J_.cols();
+    if (w.size()) {
+      for (Eigen::Index r = 0; r < m; ++r) {
+        const double sw = std::sqrt(w[r]);
+        B_.row(2 * r) = sw * J_.row(2 * r);
+        B_.row(2 * r + 1) = sw * J_.row(2 * r + 1);
+      }
+    } else {
+      B_ = J_;
+    }
+    int mm = static_cast<int>(B_.rows()), nn = static_cast<int>(n), lwork = static_cast<int>(work_.size()), info = 0;
+    dgeqrf_(&mm, &nn, B_.data(), &mm, tau_.data(), work_.data(), &lwork, &info);
+    if (info != 0) throw NumericalError("QR of the Jacobian (dgeqrf) failed: info " + std::to_string(info));
+    if (B_.rows() >= n) return B_.topRows(n).triangularView<Eigen::Upper>();
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);  // fewer real rows than columns
+    R.topRows(B_.rows()) = B_.triangularView<Eigen::Upper>();
+    return R;
+  }
+
+  Eigen::MatrixXd column_covariance(const Eigen::VectorXd& w) const {
+    if (!cached_) return real_column_covariance(d_, p_, rows_, w);
+    const Eigen::Map<const Eigen::MatrixXd> Cr(reinterpret_cast<const double*>(C_.data()), 2 * C_.rows(), C_.cols());
+    const Eigen::VectorXd c = Cr * w;  // (Re, Im) of sum_l w_l C_l[e], interleaved
+    const Eigen::Index n = J_.cols();
+    Eigen::MatrixXd CJ = Eigen::MatrixXd::Zero(n, n);
+    for (const auto& t : to_cj_) CJ(t.i, t.j) += t.c.real() * c[2 * t.e] - t.c.imag() * c[2 * t.e + 1];
+    return 0.5 * (CJ + CJ.transpose());
+  }
+
+ private:
+  struct ToCj {
+    int e, i, j;
+    cd c;
+  };
+  const FrequencyData& d_;
+  const Parametrisation& p_;
+  const std::vector<int>& rows_;
+  bool cached_ = false;
+  std::vector<std::pair<int, int>> pairs_;  // (a, b) of each entry of C_l
+  std::vector<ToCj> to_cj_;
+  Eigen::MatrixXd J_;   // 2m x n real Jacobian
+  Eigen::MatrixXcd C_;  // ne x m: the entries of C_l, one column per row
+  mutable Eigen::MatrixXd B_;
+  mutable Eigen::VectorXd tau_;
+  mutable std::vector<double> work_;
+};
+
 // R of the stacked real Jacobian: one experiment's own R, or the R factors of several
 // experiments (each n x n) stacked and reduced by one more small QR.
-Eigen::MatrixXd stacked_r_factor(const Experiments& x, const Parametrisation& p,
+Eigen::MatrixXd stacked_r_factor(const std::vector<WeightedRows>& x, const Parametrisation& p,
                                  const std::vector<Eigen::VectorXd>& w) {
-  if (x.size() == 1) return weighted_r_factor(*x.d[0], p, *x.rows[0], w[0]);
+  if (x.size() == 1) return x[0].r_factor(w[0]);
   const int n = p.n_xi();
   Eigen::MatrixXd M(static_cast<Eigen::Index>(x.size()) * n, n);
-  for (size_t e = 0; e < x.size(); ++e)
-    M.middleRows(static_cast<Eigen::Index>(e) * n, n) = weighted_r_factor(*x.d[e], p, *x.rows[e], w[e]);
+  for (size_t e = 0; e < x.size(); ++e) M.middleRows(static_cast<Eigen::Index>(e) * n, n) = x[e].r_factor(w[e]);
   Eigen::Ref<Eigen::MatrixXd> Mr = M;
   Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(Mr);
   return M.topRows(n).triangularView<Eigen::Upper>();
 }
 
 // CJ_W summed over the experiments (independent noise: the expectations add).
-Eigen::MatrixXd summed_column_covariance(const Experiments& x, const Parametrisation& p,
-                                         const std::vector<Eigen::VectorXd>& w) {
-  Eigen::MatrixXd CJ = real_column_covariance(*x.d[0], p, *x.rows[0], w[0]);
-  for (size_t e = 1; e < x.size(); ++e) CJ += real_column_covariance(*x.d[e], p, *x.rows[e], w[e]);
+Eigen::MatrixXd summed_column_covariance(const std::vector<WeightedRows>& x, const std::vector<Eigen::VectorXd>& w) {
+  Eigen::MatrixXd CJ = x[0].column_covariance(w[0]);
+  for (size_t e = 1; e < x.size(); ++e) CJ += x[e].column_covariance(w[e]);
   return CJ;
 }
 
@@ -294,8 +505,11 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     res.singular_values = s.values;
     res.cost = s.cost;
   };
+  std::vector<WeightedRows> wr;
+  wr.reserve(E);
+  for (size_t e = 0; e < E; ++e) wr.emplace_back(*x.d[e], p, *x.rows[e]);
   std::vector<Eigen::VectorXd> w(E);
-  const Eigen::MatrixXd R = stacked_r_factor(x, p, w);
+  const Eigen::MatrixXd R = stacked_r_factor(wr, p, w);
   if (opt.method == Method::LS) {
     finish(solve_ls(R, p.norm_index()));
     return res;
@@ -305,7 +519,7 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     return res;
   }
   for (size_t e = 0; e < E; ++e) w[e] = Eigen::VectorXd::Ones(x.rows[e]->size());
-  const Eigen::MatrixXd CJ = summed_column_covariance(x, p, w);
+  const Eigen::MatrixXd CJ = summed_column_covariance(wr, w);
   if (CJ.cwiseAbs().maxCoeff() == 0.0) {
     // No noise anywhere: the noise-weighted problems have no weight to apply and
     // reduce to TLS, which is exact on noise-free data.
@@ -313,7 +527,8 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     finish(solve_tls(R));
     return res;
   }
-  finish(solve_gtls(R, CJ));
+  Solved solved = solve_gtls(R, CJ);
+  finish(solved);
   if (opt.method == Method::GTLS) return res;
 
   res.converged = false;
@@ -322,7 +537,7 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     double vmax = -std::numeric_limits<double>::infinity();
     bool finite = true;
     for (size_t e = 0; e < E; ++e) {
-      v[e] = residue_variance(*x.d[e], p, *x.rows[e], res.theta);
+      v[e] = wr[e].variance(res.theta);
       vmax = std::max(vmax, v[e].maxCoeff());
       finite = finite && v[e].allFinite();
     }
@@ -334,10 +549,11 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     // rather than an infinite one.
     const double floor = vmax * 1e-14;
     for (size_t e = 0; e < E; ++e) w[e] = v[e].cwiseMax(floor).cwiseInverse();
-    const Eigen::MatrixXd Rw = stacked_r_factor(x, p, w);
-    const Eigen::MatrixXd CJw = summed_column_covariance(x, p, w);
+    const Eigen::MatrixXd Rw = stacked_r_factor(wr, p, w);
+    const Eigen::MatrixXd CJw = summed_column_covariance(wr, w);
     const Eigen::VectorXcd prev = res.theta;
-    finish(solve_gtls(Rw, CJw));
+    solved = solve_gtls(Rw, CJw, solved.x);
+    finish(solved);
     res.iterations = it;
     res.cost_history.push_back(res.cost);
     const double change = (res.theta - prev).norm() / res.theta.norm();
@@ -364,6 +580,7 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     res.iterations = fit.iterations;
     res.converged = fit.converged;
     res.cost = fit.cost * scale;
+    res.information = fit.information;
     res.cost_history.clear();
     for (double c : fit.cost_history) res.cost_history.push_back(c * scale);
   }

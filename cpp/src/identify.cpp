@@ -233,7 +233,8 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
         if (E == 1) {
           const ExactLikelihood lik(*ds[0], p, rows[0]);
           if (opt.method == Method::SML) {
-            Eigen::MatrixXd F = lik.fisher_information(er.theta);
+            // The information the fit's last step computed at this very theta (the same sum).
+            Eigen::MatrixXd F = er.information.size() ? er.information : lik.fisher_information(er.theta);
             Eigen::LDLT<Eigen::MatrixXd> ldlt(F);
             if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0))
               throw NumericalError("the Fisher information is singular");
@@ -247,8 +248,12 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
           Eigen::MatrixXd bread, meat;
           Eigen::Index at = 0;
           for (size_t e = 0; e < E; ++e) {
-            const ExactLikelihood lik(*ds[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
             const Eigen::Index n = static_cast<Eigen::Index>(rows[e].size());
+            if (opt.method == Method::SML && er.information.size()) {  // the fit's, summed already
+              bread = er.information;
+              break;
+            }
+            const ExactLikelihood lik(*ds[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
             if (opt.method == Method::SML) {
               const Eigen::MatrixXd F = lik.fisher_information(er.theta);
               if (e == 0) bread = F; else bread += F;

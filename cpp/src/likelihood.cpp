@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "lptv/errors.hpp"
 #include "lptv/jacobian.hpp"
@@ -161,7 +162,8 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
         }
     }
   }
-  // Banded Cholesky in place: O(n kd^2).
+  // Banded Cholesky in place: O(n kd^2). (LAPACK's dpbtrf is slower at these bandwidths,
+  // kd = 4K + 1: it calls the BLAS once per column.)
   const double smax = f.Lb.row(0).maxCoeff();
   for (int j = 0; j < n; ++j) {
     double djj = f.Lb(0, j);
@@ -185,14 +187,29 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
 
 namespace {
 
-// X <- L^{-1} X, L lower banded (Lb(i - j, j)), column by column of X.
+// X <- L^{-1} X, L lower banded (Lb(i - j, j)). One column: in place. Several: on the
+// transpose, so that each elimination step updates contiguous rows of X (a column-major X's
+// rows are strided).
 void forward_solve(const Eigen::MatrixXd& Lb, int kd, Eigen::Ref<Eigen::MatrixXd> X) {
   const Eigen::Index n = Lb.cols();
-  for (Eigen::Index j = 0; j < n; ++j) {
-    X.row(j) /= Lb(0, j);
-    const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd);
-    for (Eigen::Index i = j + 1; i <= last; ++i) X.row(i) -= Lb(i - j, j) * X.row(j);
+  if (X.cols() == 1) {
+    double* x = X.data();
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double xj = x[j] / Lb(0, j);
+      x[j] = xj;
+      const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd);
+      const double* l = &Lb(0, j);
+      for (Eigen::Index i = j + 1; i <= last; ++i) x[i] -= l[i - j] * xj;
+    }
+    return;
   }
+  Eigen::MatrixXd Xt = X.transpose();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    Xt.col(j) /= Lb(0, j);
+    const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd);
+    for (Eigen::Index i = j + 1; i <= last; ++i) Xt.col(i) -= Lb(i - j, j) * Xt.col(j);
+  }
+  X = Xt.transpose();
 }
 
 // x <- L^{-T} x.
@@ -215,17 +232,28 @@ double ExactLikelihood::cost(const Eigen::VectorXcd& theta) const {
 }
 
 Eigen::MatrixXd ExactLikelihood::real_jacobian(const FrequencyData& x) const {
-  // dr/dxi = [Re; Im] of J Text, rows interleaved; J[l, q] = +-s^n X_{l-k}.
+  // dr/dxi = [Re; Im] of J Text, rows interleaved; J[l, q] = +-s^n X_{l-k}. Text has one or
+  // two nonzeros per row: its nonzeros are listed once, not multiplied as a dense matrix.
   const detail::Lines X{x};
   const Eigen::MatrixXcd& T = p_.Text();
+  struct Nz {
+    int q, c;
+    cd v;
+  };
+  std::vector<Nz> nz;
+  for (int c = 0; c < T.cols(); ++c)
+    for (int q = 0; q < T.rows(); ++q)
+      if (T(q, c) != cd(0.0, 0.0)) nz.push_back({q, c, T(q, c)});
   const int R = static_cast<int>(sorted_.size());
   Eigen::MatrixXd out(2 * R, p_.n_xi());
   detail::RowPowers pw(p_.structure());
-  Eigen::RowVectorXcd j(p_.n_theta());
+  std::vector<cd> j(static_cast<size_t>(p_.n_theta()));
+  Eigen::RowVectorXcd jt(p_.n_xi());
   for (int r = 0; r < R; ++r) {
     pw.compute(sorted_[r]);
     detail::jacobian_row(p_, X, pw, sorted_[r], j.data());
-    const Eigen::RowVectorXcd jt = j * T;
+    jt.setZero();
+    for (const Nz& e : nz) jt[e.c] += j[static_cast<size_t>(e.q)] * e.v;
     out.row(2 * r) = jt.real();
     out.row(2 * r + 1) = jt.imag();
   }
@@ -329,18 +357,22 @@ ExactLikelihood::SandwichTerms ExactLikelihood::sandwich_terms(const Eigen::Vect
 
 namespace {
 
-// Levenberg-Marquardt on V; `evaluate(theta)` gives the cost, the whitened residue and the
-// whitened Jacobian (of one experiment, or of several stacked).
-template <class Evaluate>
-ExactFit minimise(const Evaluate& evaluate, const Parametrisation& p, const Eigen::VectorXcd& theta0,
-                  double tol, int max_iter) {
+// Levenberg-Marquardt on V. `trial(theta)` factors S and gives the cost (a pair: the
+// factors, the cost: what a trial step needs); `complete(t)` gives from it the whitened residue
+// and the whitened Jacobian (of one experiment, or of several stacked), so the Jacobian is
+// built only at accepted steps and S is factored once per step. A step whose predicted
+// decrease of V is at rounding level (8 eps V) is not tried: V is at its minimum to
+// rounding, and raising lambda up to 1e12 to find that out took up to 15 evaluations.
+template <class Trial, class Complete>
+ExactFit minimise(const Trial& trial, const Complete& complete, const Parametrisation& p,
+                  const Eigen::VectorXcd& theta0, double tol, int max_iter) {
   const std::vector<int> free = p.free_indices();
   const int nf = static_cast<int>(free.size());
   ExactFit fit;
   fit.xi = p.xi_from_theta(theta0);
   fit.theta = p.theta_from_xi(fit.xi);
   fit.xi = p.xi_from_theta(fit.theta);  // normalised
-  ExactLikelihood::Evaluation ev = evaluate(fit.theta);
+  ExactLikelihood::Evaluation ev = complete(trial(fit.theta));
   auto half_gradient = [&](const ExactLikelihood::Evaluation& e, Eigen::MatrixXd& J) {
     J = free_columns(e.jacobian, free);
     return Eigen::VectorXd(J.transpose() * e.whitened);
@@ -350,30 +382,42 @@ ExactFit minimise(const Evaluate& evaluate, const Parametrisation& p, const Eige
   double lambda = 1e-3;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
   for (int it = 1; it <= max_iter; ++it) {
-    const Eigen::MatrixXd H = J.transpose() * J;
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(J.cols(), J.cols());
+    H.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+    H.triangularView<Eigen::StrictlyUpper>() = H.transpose();
     const Eigen::VectorXd D = H.diagonal().cwiseMax(kEps * H.diagonal().maxCoeff());
     bool accepted = false;
     Eigen::VectorXd step, xi_t;
     Eigen::VectorXcd theta_t;
     ExactLikelihood::Evaluation ev_t;
+    bool at_rounding = false;
     while (lambda < 1e12) {
       Eigen::MatrixXd Hl = H;
       Hl.diagonal() += lambda * D;
       step = Hl.ldlt().solve(-g);
+      // V(xi + s) ~ V + 2 g^T s + s^T H s (g the half gradient): the predicted decrease.
+      const double predicted = -(2.0 * g.dot(step) + step.dot(H * step));
+      if (!(predicted > 8 * kEps * ev.cost)) {
+        at_rounding = true;
+        break;
+      }
       xi_t = fit.xi;
       for (int c = 0; c < nf; ++c) xi_t[free[c]] += step[c];
       try {
         theta_t = p.theta_from_xi(xi_t);
-        ev_t = evaluate(theta_t);
+        auto t = trial(theta_t);
+        if (t.second <= ev.cost) {
+          ev_t = complete(t);
+          accepted = true;
+          break;
+        }
       } catch (const NumericalError&) {  // a step into a region where S is singular
-        lambda *= 10;
-        continue;
-      }
-      if (ev_t.cost <= ev.cost) {
-        accepted = true;
-        break;
       }
       lambda *= 10;
+    }
+    if (at_rounding) {
+      fit.converged = true;
+      break;
     }
     if (!accepted) {  // no step lowers V: a minimum to rounding
       fit.converged = true;
@@ -405,8 +449,17 @@ ExactFit minimise(const Evaluate& evaluate, const Parametrisation& p, const Eige
 
 ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
                              const Eigen::VectorXcd& theta0, double tol, int max_iter) {
-  return minimise([&](const Eigen::VectorXcd& theta) { return lik.evaluate(theta); }, p, theta0, tol,
-                  max_iter);
+  // A trial: S factored at theta (first) and the cost there (second).
+  using Factored = std::pair<ExactLikelihood::Factor, double>;
+  auto trial = [&](const Eigen::VectorXcd& theta) {
+    Factored t{lik.factor(theta), 0.0};
+    Eigen::VectorXd r = t.first.r;
+    forward_solve(t.first.Lb, lik.kd_, r);
+    t.second = r.squaredNorm();
+    return t;
+  };
+  auto complete = [&](const Factored& t) { return lik.evaluate(t.first, true); };
+  return minimise(trial, complete, p, theta0, tol, max_iter);
 }
 
 ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
@@ -414,11 +467,22 @@ ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Par
   if (liks.empty()) throw std::invalid_argument("experiments: the list is empty");
   if (liks.size() == 1) return minimise_exact_cost(liks[0], p, theta0, tol, max_iter);
   // S block diagonal over the experiments: the whitened residues and Jacobians stack.
-  auto evaluate = [&](const Eigen::VectorXcd& theta) {
+  using FactoredAll = std::pair<std::vector<ExactLikelihood::Factor>, double>;
+  auto trial = [&](const Eigen::VectorXcd& theta) {
+    FactoredAll t{{}, 0.0};
+    for (const ExactLikelihood& lik : liks) {
+      t.first.push_back(lik.factor(theta));
+      Eigen::VectorXd r = t.first.back().r;
+      forward_solve(t.first.back().Lb, lik.kd_, r);
+      t.second += r.squaredNorm();
+    }
+    return t;
+  };
+  auto complete = [&](const FactoredAll& t) {
     std::vector<ExactLikelihood::Evaluation> parts;
     Eigen::Index rows = 0;
-    for (const ExactLikelihood& lik : liks) {
-      parts.push_back(lik.evaluate(theta));
+    for (size_t e = 0; e < liks.size(); ++e) {
+      parts.push_back(liks[e].evaluate(t.first[e], true));
       rows += parts.back().whitened.size();
     }
     ExactLikelihood::Evaluation ev;
@@ -433,7 +497,7 @@ ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Par
     }
     return ev;
   };
-  return minimise(evaluate, p, theta0, tol, max_iter);
+  return minimise(trial, complete, p, theta0, tol, max_iter);
 }
 
 Eigen::MatrixXd ExactLikelihood::residue_covariance(const Eigen::VectorXcd& theta) const {

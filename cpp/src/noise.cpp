@@ -1,5 +1,7 @@
 #include "lptv/noise.hpp"
 
+#include <unsupported/Eigen/FFT>
+
 #include <stdexcept>
 #include <string>
 
@@ -44,11 +46,21 @@ FrequencyData frequency_data_from_periods(const Eigen::MatrixXd& u, const Eigen:
   if (u.cols() < 2) throw std::invalid_argument("u, y: a period needs at least 2 samples");
   if (!u.allFinite()) throw std::invalid_argument("u contains NaN or inf");
   if (!y.allFinite()) throw std::invalid_argument("y contains NaN or inf");
-  const Eigen::Index nl = u.cols() / 2 + 1;
+  const Eigen::Index N = u.cols(), nl = N / 2 + 1;
   Eigen::MatrixXcd Up(nl, P), Yp(nl, P);
+  // One FFT object for every period (its plan and twiddles made once), half spectra only.
+  Eigen::FFT<double> fft;
+  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  Eigen::VectorXd row(N);
+  Eigen::VectorXcd X(nl);
+  const double inv_n = 1.0 / double(N);
   for (int p = 0; p < P; ++p) {
-    Up.col(p) = spectrum(u.row(p).transpose());
-    Yp.col(p) = spectrum(y.row(p).transpose());
+    row = u.row(p).transpose();
+    fft.fwd(X, row);
+    Up.col(p) = X.head(nl) * inv_n;
+    row = y.row(p).transpose();
+    fft.fwd(X, row);
+    Yp.col(p) = X.head(nl) * inv_n;
   }
   FrequencyData d;
   d.periods = P;

@@ -36,6 +36,9 @@ struct EstimateResult {
   // ascending (empty for LS). Two close smallest ones mean a near-unidentifiable model.
   Eigen::VectorXd singular_values;
   bool noise_free = false;           // the data carry no noise: GTLS/WGTLS fell back to TLS
+  // SML: the Fisher information of the free parameters at the estimate (J^T J of the whitened
+  // Jacobian, summed over the experiments), which the last step computed; empty otherwise.
+  Eigen::MatrixXd information;
 };
 
 // The R factor (n_xi x n_xi) of the real Jacobian [Re(J Text); Im(J Text)] with row l
@@ -55,7 +58,10 @@ struct GtlsSolve {
   Eigen::VectorXd x;
   Eigen::VectorXd values;
 };
-GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ);
+// start (optional): a guess of x (the previous WGTLS solve's); with it and a gap between the
+// two smallest values the vector comes by inverse iteration instead of a full SVD.
+GtlsSolve gtls_from_r(const Eigen::MatrixXd& R, const Eigen::MatrixXd& CJ,
+                      const Eigen::VectorXd& start = Eigen::VectorXd());
 
 EstimateResult estimate(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
                         const EstimateOptions& opt = EstimateOptions());

@@ -21,6 +21,8 @@ namespace lptv {
 // x0 = x - Cov(n) M^T q, the data nearest to x that the model explains exactly (the
 // noiseless spectra the likelihood eliminates). The whitened Jacobian L^{-1} M_j x0 thus
 // gives the exact gradient and the Gauss-Newton (Fisher) approximation of the Hessian.
+struct ExactFit;
+
 class ExactLikelihood {
  public:
   ExactLikelihood(const FrequencyData& d, const Parametrisation& p, std::vector<int> rows);
@@ -68,6 +70,12 @@ class ExactLikelihood {
 
  private:
   struct Factor;  // the banded Cholesky factor of S and the per-entry blocks
+  // The fit's trial steps need the cost only and its accepted steps the rest from the same
+  // factor: it reaches both through the private factor() and evaluate(Factor).
+  friend ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& p,
+                                      const Eigen::VectorXcd& theta0, double tol, int max_iter);
+  friend ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
+                                      const Eigen::VectorXcd& theta0, double tol, int max_iter);
   void init(const std::vector<int>& rows);  // sorted rows and bandwidth, after the checks
   Factor factor(const Eigen::VectorXcd& theta) const;
   // With whiten = false: cost, w and x0, and the Jacobian at x0 not whitened (no gradient).
