@@ -338,20 +338,36 @@ ExactLikelihood::SandwichTerms ExactLikelihood::sandwich_terms(const Eigen::Vect
   if (weights.size() != R) throw std::invalid_argument("weights must have one entry per row");
   const Factor f = factor(theta);
   Eigen::MatrixXd J = free_columns(evaluate(f, false).jacobian, p_.free_indices());
-  for (int r = 0; r < R; ++r) J.middleRows(2 * r, 2) *= weights[order_[r]];  // W J
-  // J^T W S W J = (L^T W J)^T (L^T W J): L^T applied to each column from the band.
-  const Eigen::Index n = 2 * R;
-  Eigen::MatrixXd LtWJ = Eigen::MatrixXd::Zero(n, J.cols());
+  // H = J^T W J and J^T W S W J = (L^T W J)^T (L^T W J), both symmetric (rank updates, half
+  // the flops of a product). Built on the transposes (columns = real rows), so that L^T is
+  // applied to contiguous vectors: Xt = (W J)^T, column j of (L^T W J)^T = sum_i L(i, j) Xt(:, i).
+  const Eigen::Index n = 2 * R, nc = J.cols();
+  Eigen::MatrixXd Xt = J.transpose();
+  Eigen::MatrixXd St(nc, n);  // sqrt(W) J, transposed
+  for (int r = 0; r < R; ++r) {
+    const double w = weights[order_[r]];
+    const double sw = std::sqrt(std::max(w, 0.0));
+    St.middleCols(2 * r, 2) = sw * Xt.middleCols(2 * r, 2);
+    Xt.middleCols(2 * r, 2) *= w;
+  }
+  Eigen::MatrixXd LtWJt(nc, n);
   for (Eigen::Index j = 0; j < n; ++j) {
     const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd_);
-    for (Eigen::Index i = j; i <= last; ++i) LtWJ.row(j) += f.Lb(i - j, j) * J.row(i);
+    auto col = LtWJt.col(j);
+    col = f.Lb(0, j) * Xt.col(j);
+    for (Eigen::Index i = j + 1; i <= last; ++i) col += f.Lb(i - j, j) * Xt.col(i);
   }
   SandwichTerms t;
-  t.meat = LtWJ.transpose() * LtWJ;
-  // H = J^T W J = (W J)^T J with the unweighted J: divide the weights back out.
-  Eigen::MatrixXd J1 = J;
-  for (int r = 0; r < R; ++r) J1.middleRows(2 * r, 2) /= weights[order_[r]];
-  t.bread = J.transpose() * J1;
+  t.meat = Eigen::MatrixXd::Zero(nc, nc);
+  t.meat.selfadjointView<Eigen::Lower>().rankUpdate(LtWJt);
+  t.meat.triangularView<Eigen::StrictlyUpper>() = t.meat.transpose();
+  if (weights.minCoeff() >= 0) {
+    t.bread = Eigen::MatrixXd::Zero(nc, nc);
+    t.bread.selfadjointView<Eigen::Lower>().rankUpdate(St);
+    t.bread.triangularView<Eigen::StrictlyUpper>() = t.bread.transpose();
+  } else {  // weights of any sign (not a fit's): the plain product
+    t.bread = Xt * J;
+  }
   return t;
 }
 

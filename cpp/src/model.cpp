@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 #include <string>
 
 namespace lptv {
@@ -123,12 +124,15 @@ Eigen::MatrixXd evaluate_fourier(const Eigen::MatrixXcd& coef, double w0,
                                  const Eigen::VectorXd& t) {
   const Eigen::Index K = (coef.cols() - 1) / 2;
   Eigen::MatrixXd out(t.size(), coef.rows());
+  std::vector<cd> phasor(static_cast<size_t>(K) + 1);
   for (Eigen::Index i = 0; i < t.size(); ++i) {
+    // e^{jkwt} once per time and harmonic, shared by the coefficients
+    for (Eigen::Index k = 1; k <= K; ++k) phasor[static_cast<size_t>(k)] = std::polar(1.0, double(k) * w0 * t[i]);
     for (Eigen::Index n = 0; n < coef.rows(); ++n) {
       double v = coef(n, K).real();
       for (Eigen::Index k = 1; k <= K; ++k) {
         // c_k e^{jkwt} + conj(c_k) e^{-jkwt} = 2 Re(c_k e^{jkwt})
-        v += 2.0 * (coef(n, K + k) * std::polar(1.0, double(k) * w0 * t[i])).real();
+        v += 2.0 * (coef(n, K + k) * phasor[static_cast<size_t>(k)]).real();
       }
       out(i, n) = v;
     }
