@@ -10,7 +10,8 @@
 // and an SVD of the 35 x 35 triangle with its right singular vectors (dgesvd, jobvt = 'A'),
 // both on one thread, as the estimator runs. A fit's floor is its number of steps times
 // that: WGTLS, its GTLS start and each weighted solve (1 + iterations); SML, those of its
-// WGTLS start and each Levenberg-Marquardt step. Every route is timed in the same run,
+// WGTLS start (stopped at 1e-6, EstimateResult::start_iterations) and each accepted
+// Levenberg-Marquardt step. Every route is timed in the same run,
 // taking turns, each one's fastest round counting (the least disturbed by other work).
 //
 // Usage: bench_estimate_floor [seeds]   (default 3)
@@ -156,7 +157,7 @@ int main(int argc, char** argv) {
       ts = std::min(ts, bench::min_time(1, [&] { (void)lptv::estimate(d, p, rows, os); }));
       tf = std::min(tf, bench::min_time(3, [&] { floor.run(); }));
     }
-    const int steps_w = 1 + rw.iterations, steps_s = steps_w + rs.iterations;
+    const int steps_w = 1 + rw.iterations, steps_s = 1 + rs.start_iterations + rs.iterations;
     const double fw = steps_w * tf, fs = steps_s * tf;
     std::printf("%4d %4.0fus %7.2fms %9d %7.2fms %5.2fx %7.2fms %9d %5.2fms %6.2fx\n", seed, 1e6 * tf, 1e3 * tw,
                 steps_w, 1e3 * fw, tw / fw, 1e3 * ts, steps_s, 1e3 * fs, ts / fs);

@@ -533,6 +533,11 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
 
   res.converged = false;
   std::vector<Eigen::VectorXd> v(E);
+  // SML only starts from the WGTLS estimate: its Gauss-Newton steps converge from any
+  // consistent start, so WGTLS is stopped at a relative change of 1e-6 (each further
+  // WGTLS solve costs as much as a Gauss-Newton step and moves the start by less than SML's
+  // first step moves it).
+  const double wgtls_tol = opt.method == Method::SML ? std::max(opt.tol, 1e-6) : opt.tol;
   for (int it = 1; it <= opt.max_iter; ++it) {
     double vmax = -std::numeric_limits<double>::infinity();
     bool finite = true;
@@ -557,7 +562,7 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     res.iterations = it;
     res.cost_history.push_back(res.cost);
     const double change = (res.theta - prev).norm() / res.theta.norm();
-    if (change < opt.tol) {
+    if (change < wgtls_tol) {
       res.converged = true;
       break;
     }
@@ -577,6 +582,7 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     const double scale = 1.0 / (2.0 * static_cast<double>(n_rows));
     res.theta = fit.theta;
     res.eta = p.eta_from_xi(fit.xi);
+    res.start_iterations = res.iterations;
     res.iterations = fit.iterations;
     res.converged = fit.converged;
     res.cost = fit.cost * scale;

@@ -15,6 +15,8 @@ void bind_estimators(py::module_& m) {
       .def_readonly("theta", &lptv::EstimateResult::theta)
       .def_readonly("eta", &lptv::EstimateResult::eta)
       .def_readonly("iterations", &lptv::EstimateResult::iterations)
+      .def_readonly("start_iterations", &lptv::EstimateResult::start_iterations,
+                    "SML: the weighted solves of its WGTLS start (stopped at a relative change of 1e-6)")
       .def_readonly("converged", &lptv::EstimateResult::converged)
       .def_readonly("cost", &lptv::EstimateResult::cost)
       .def_readonly("cost_history", &lptv::EstimateResult::cost_history)

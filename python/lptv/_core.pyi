@@ -240,6 +240,11 @@ class EstimateResult:
     def singular_values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
     @property
+    def start_iterations(self) -> int:
+        """
+        SML: the weighted solves of its WGTLS start (stopped at a relative change of 1e-6)
+        """
+    @property
     def theta(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
         ...
 class Identification:

@@ -206,15 +206,22 @@ def as_seed(seed, name="seed"):
 def as_int_list(x, name, minimum=0, maximum=INT_MAX):
     """A 1-D sequence of whole numbers, each in [minimum, maximum], as a list of int.
 
-    A ``range`` or an integer NumPy array is checked as a whole (its bounds), not entry by
-    entry; anything else, and any out-of-range entry, goes through :func:`as_int` per entry,
+    A ``range``, an integer NumPy array or a list of integers is checked as a whole (its
+    bounds), not entry by entry; anything else, and any out-of-range entry, goes through :func:`as_int` per entry,
     which names what is wrong."""
     if isinstance(x, range):
         if len(x) == 0 or (min(x[0], x[-1]) >= minimum and max(x[0], x[-1]) <= maximum):
             return list(x)
-    elif isinstance(x, np.ndarray) and x.ndim == 1 and x.dtype.kind in "iu":
-        if x.size == 0 or (int(x.min()) >= minimum and int(x.max()) <= maximum):
-            return x.tolist()
+    else:
+        arr = x
+        if isinstance(x, (list, tuple)) and len(x) > 8 and not any(isinstance(v, (bool, np.bool_)) for v in x):
+            try:
+                arr = np.asarray(x)   # a list of Python or NumPy integers: dtype int64
+            except (TypeError, ValueError, OverflowError):
+                arr = x
+        if isinstance(arr, np.ndarray) and arr.ndim == 1 and arr.dtype.kind in "iu":
+            if arr.size == 0 or (int(arr.min()) >= minimum and int(arr.max()) <= maximum):
+                return arr.tolist()
     if isinstance(x, (str, bytes)) or np.ndim(x) != 1:
         shape = "a string" if isinstance(x, (str, bytes)) else f"shape {np.shape(x)}"
         raise ValueError(f"{name} must be a 1-D sequence of integers, got {shape}")

@@ -27,6 +27,7 @@ struct EstimateResult {
   Eigen::VectorXcd theta;            // all complex parameters (Parametrisation order)
   Eigen::VectorXd eta;               // free real parameters
   int iterations = 0;                // WGTLS: weighted solves after the GTLS start; SML: LM steps
+  int start_iterations = 0;          // SML: the weighted solves of its WGTLS start
   bool converged = true;
   // The method's objective at the estimate; SML: V / (2 |R|), the mean of |e_l|^2 / var e_l
   // for uncorrelated rows.
