@@ -49,7 +49,9 @@ def _one_line(e):
 
 @dataclass(frozen=True)
 class Measurements:
-    """What a measurement file holds: P periods of N samples of u and y."""
+    """What a measurement file holds: P periods of N samples of u and y, shape (P, N); or, read
+    with ``realisations=True`` from 3-D variables, M random-phase realisations of P periods
+    each, shape (M, P, N) (see :attr:`realisations`)."""
 
     u: np.ndarray
     y: np.ndarray
@@ -67,6 +69,11 @@ class Measurements:
     """The file's name of the output channel."""
     fs_source: Optional[str] = None
     """Where fs came from: None when given (or unknown), else e.g. "column 'time'" or "variable 'fs'"."""
+
+    @property
+    def realisations(self) -> Optional[int]:
+        """M for a record of realisations (``u`` of shape (M, P, N)), None for periods alone."""
+        return int(self.u.shape[0]) if self.u.ndim == 3 else None
 
 
 @dataclass
@@ -88,7 +95,8 @@ class _Raw:
 def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float] = None,
                       dt: Optional[float] = None, period: Optional[float] = None,
                       trim: bool = False, skip_periods: int = 0, u: Optional[str] = None,
-                      y: Optional[str] = None, time: Optional[str] = None) -> Measurements:
+                      y: Optional[str] = None, time: Optional[str] = None,
+                      realisations: bool = False) -> Measurements:
     """Read u, y (shape (P, N)) and an optional w0 from a CSV, NPZ or MATLAB file.
 
     Parameters
@@ -120,6 +128,12 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     time : str, optional
         The name of a time column or variable in s (default: one named ``t`` or ``time``,
         also with a unit, ``time [s]``, ``t_ms``).
+    realisations : bool
+        Accept NPZ/MAT variables of shape (M, P, N): M >= 2 realisations (random-phase
+        multisines of one amplitude spectrum, for :func:`lptv.distortion`), each of P periods
+        (each realisation may also be one long vector, shape (M, samples), split as above).
+        ``u`` and ``y`` of the result then have shape (M, P, N); ``skip_periods`` drops periods
+        of every realisation. Without it such variables are refused, naming this option.
 
     Raises :class:`FileError` with a message naming the problem (not the file).
 
@@ -176,20 +190,30 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
                             f"rad/s (period {2 * np.pi / w0:.10g} s)")
     if raw.kind == "column":
         u_p, y_p = _csv_periods(raw, split)
+    elif _is_realisations(raw):
+        if not realisations:
+            raise FileError(f"variable '{raw.names[0]}' has shape {_shape(np.asarray(raw.u))}: M realisations "
+                            "x P periods x N samples, read by lptv identify FILE given alone (in Python: "
+                            "lptv.read_measurements(..., realisations=True) and lptv.distortion)")
+        u_p = _realisations(raw.names[0], raw.u, split, "u")
+        y_p = _realisations(raw.names[1], raw.y, split, "y")
     else:
         u_p = _as_periods(raw.names[0], raw.u, split, "u")
         y_p = _as_periods(raw.names[1], raw.y, split, "y")
     if fs is not None and split.period is None and source is None:
         raise FileError("--fs needs the period: give --period (s) or --w0 (rad/s), or store w0 in the file")
     if u_p.shape != y_p.shape:
-        raise FileError(f"u and y differ in shape: u is {_shape(u_p)} and y is {_shape(y_p)} (periods x samples)")
-    if u_p.shape[0] < 2:
-        raise FileError("the record holds only 1 period; the noise model needs at least 2")
+        raise FileError(f"u and y differ in shape: u is {_shape(u_p)} and y is {_shape(y_p)} "
+                        + ("(realisations x periods x samples)" if u_p.ndim == 3 else "(periods x samples)"))
+    if u_p.shape[-2] < 2:
+        raise FileError("the record holds only 1 period" + (" per realisation" if u_p.ndim == 3 else "")
+                        + "; the noise model needs at least 2")
     if skip_periods:
-        if u_p.shape[0] - skip_periods < 2:
-            raise FileError(f"--skip-periods {skip_periods} leaves {u_p.shape[0] - skip_periods} of "
-                            f"{u_p.shape[0]} periods; the noise model needs at least 2")
-        u_p, y_p = u_p[skip_periods:], y_p[skip_periods:]
+        P = u_p.shape[-2]
+        if P - skip_periods < 2:
+            raise FileError(f"--skip-periods {skip_periods} leaves {P - skip_periods} of "
+                            f"{P} periods; the noise model needs at least 2")
+        u_p, y_p = u_p[..., skip_periods:, :], y_p[..., skip_periods:, :]
     return Measurements(u=u_p, y=y_p, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods,
                         input=raw.names[0], output=raw.names[1], fs_source=source)
 
@@ -408,6 +432,25 @@ def _split_periods(what, v, periods):
         raise FileError(f"{what} has {v.size} samples, not a whole number of periods "
                         f"({v.size} / {periods} = {v.size / periods:.6g})")
     return v.reshape(periods, -1)
+
+
+def _is_realisations(raw) -> bool:
+    """The input variable is 3-D: (M, P, N) realisations x periods x samples."""
+    return np.ndim(raw.u) == 3
+
+
+def _realisations(name, a, split, role):
+    """(M, P, N) from a 3-D variable: each realisation read as a (P, N) record."""
+    a = np.asarray(a)
+    if a.shape[0] < 2:
+        raise FileError(f"variable '{name}' holds {a.shape[0]} realisation; at least 2 are needed "
+                        "to separate the nonlinear distortion from the noise")
+    parts = [_as_periods(f"{name}[{m}]", a[m], split, role) for m in range(a.shape[0])]
+    shapes = {p.shape for p in parts}
+    if len(shapes) > 1:
+        raise FileError(f"variable '{name}': its realisations differ in shape "
+                        f"({', '.join(_shape(p) for p in parts[:3])}...)")
+    return np.stack(parts)
 
 
 def _as_periods(name, a, split, role):

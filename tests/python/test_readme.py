@@ -67,6 +67,16 @@ def test_readme_real_rig_example_runs(tmp_path, monkeypatch):
     assert d.detected and ns["ax"].get_ylabel() == "power (dB)"
     assert np.isfinite(ns["G"][d.branches]).all()            # branch 0 at every excited line
     assert abs(bla.residue_tests.tests[0].statistic) < 5
+    # ... and the command line on the file the block saves, as the README prints it
+    import json
+    import shlex
+
+    from lptv.apps import cli
+
+    cmd = re.search(r"```sh\n(lptv identify rig\.npz[^\n]*)\n```", README.read_text()).group(1)
+    assert cli.main(shlex.split(cmd)[1:]) == 0
+    s = json.loads((tmp_path / "rig-lptv" / "summary.json").read_text())
+    assert s["realisations"] == 6 and s["distortion"]["detected"] and (tmp_path / "rig-lptv" / "distortion.png").exists()
 
 
 def test_readme_excitation_design_example_runs(tmp_path, monkeypatch):

@@ -9,7 +9,9 @@ The file holds P >= 2 steady-state periods of the input u and the output y:
 - CSV: a header row naming the columns (``u`` and ``y``, or ``--input NAME --output NAME``;
   other columns are ignored), one sample per row, the periods one after another.
 - NPZ: arrays (``u`` and ``y`` or as named) of shape (P, N) or long vectors, optionally a scalar
-  ``w0`` (rad/s).
+  ``w0`` (rad/s). Arrays of shape (M, P, N) hold M random-phase realisations of one amplitude
+  spectrum: the nonlinear distortion is separated from the noise and the best linear
+  (time-periodic) approximation identified with it (:mod:`lptv.apps.blaid`).
 - MATLAB ``.mat`` (v4/v5/v7 via scipy, v7.3 via h5py): variables as in NPZ.
 
 A long record is split by ``--periods`` or by the sampling frequency and the period: fs is
@@ -114,9 +116,9 @@ def fundamental(args, meas):
             raise FileError(f"{given} gives w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
         w0, given = meas.w0, "the file's w0"
     if meas.fs is not None and w0 is None:
-        w0 = 2 * np.pi * meas.fs / meas.u.shape[1]
+        w0 = 2 * np.pi * meas.fs / meas.u.shape[-1]
     if positive(args.ts, "--ts") is not None:
-        n = meas.u.shape[1]
+        n = meas.u.shape[-1]
         w0_ts = 2 * np.pi / (n * args.ts)
         if w0 is None:
             w0 = w0_ts
@@ -134,7 +136,9 @@ Identify an LPTV model from P >= 2 measured steady-state periods of input u and 
   .csv  header row naming the columns (u and y, or --input NAME --output NAME), periods one
         after another; a time column (t, time, time [s], or --time NAME) gives fs
   .npz  arrays u, y (or as named) of shape (P, N) or one long vector each; optional scalars w0
-        (rad/s) and fs (Hz) or dt / Ts (s), or a time vector t
+        (rad/s) and fs (Hz) or dt / Ts (s), or a time vector t. Shape (M, P, N): M random-phase
+        realisations; the report then shows the nonlinear distortion and the model is the best
+        linear approximation with its variance
   .mat  MATLAB v5 or v7.3: variables as in .npz
 A long record is split into periods by --periods, or by fs (--fs / --dt, else the file's time
 or stored fs) and the period (--period / --w0); the first line of the output says which fs.
@@ -261,7 +265,7 @@ def run(args) -> int:
         for opt in ("na", "nb", "max_iter"):
             integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         positive(args.tol, "--tol")
-        meas = read_record(src, args)
+        meas = read_record(src, args, realisations=True)
         if args.discrete and args.ts is not None:
             raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
         if args.discrete and meas.fs is None:
@@ -270,6 +274,10 @@ def run(args) -> int:
         if args.discrete:
             args.ts = ts
         w0 = fundamental(args, meas)
+        if meas.realisations:
+            from lptv.apps import blaid
+
+            return blaid.run(args, src, meas, w0=w0, ts=ts, lines=lines, ka=ka, kb=kb, known=known)
         record = check_record(meas.u, meas.y, warn=False)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -459,9 +467,10 @@ def read_options(args) -> dict:
                 skip_periods=args.skip_periods, u=args.input, y=args.output, time=args.time)
 
 
-def read_record(src, args):
-    """The periods of one file as the options say (:func:`read_options`)."""
-    return read_measurements(src, **read_options(args))
+def read_record(src, args, realisations: bool = False):
+    """The periods of one file as the options say (:func:`read_options`); with ``realisations``
+    also M x P x N records of random-phase realisations."""
+    return read_measurements(src, **read_options(args), realisations=realisations)
 
 
 def describe_record(meas) -> str:

@@ -1,0 +1,92 @@
+"""``lptv identify FILE`` on M random-phase realisations (arrays of shape (M, P, N)).
+
+The command must separate the nonlinear distortion from the noise as :func:`lptv.distortion`
+does on the same numbers, fit the best linear approximation as :func:`lptv.identify` does on
+``DistortionResult.experiments()``, and say so in its output, summary.json and report; a
+purely LPTV record must show no distortion. Readers other than ``lptv identify FILE`` refuse
+such a file with a message naming the option.
+"""
+import json
+
+import numpy as np
+import pytest
+
+import lptv
+from lptv.apps import cli
+from lptv.examples import noisy_periods
+from lptv.measurements import FileError
+
+MODEL = lptv.Model([[0.3 + 0.1j, 2.0, 0.3 - 0.1j], [0, 1.0, 0]], [[0, 1.0, 0]], w0=0.05)
+ARGS = ["--na", "1", "--nb", "0", "--ka", "1", "--kb", "1"]
+
+
+def _record(path, cubic, M=4, P=8, N=256, seed=0):
+    u, y = [], []
+    for r in range(M):
+        ms = lptv.multisine(range(4, min(61, N // 4), 4), N, seed=seed + r)
+        y0 = lptv.time_signal(lptv.simulate(MODEL, ms.spectrum), N)
+        a, b = noisy_periods(ms.signal, y0 + cubic * y0 ** 3, P, 60, 40, seed=100 + seed + r)
+        u.append(a)
+        y.append(b)
+    u, y = np.array(u), np.array(y)
+    np.savez(path, u=u, y=y, w0=MODEL.w0)
+    return u, y
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_identify_file_of_realisations_matches_the_library(tmp_path, seed, capsys):
+    src = tmp_path / "rig.npz"
+    u, y = _record(src, cubic=0.5, seed=seed)
+    out = tmp_path / "out"
+    assert cli.main(["identify", str(src), *ARGS, "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "4 realisations x 8 periods of 256 samples" in printed
+    assert "nonlinear distortion DETECTED" in printed
+    s = json.loads((out / "summary.json").read_text())
+    d = lptv.distortion(u, y, w0=MODEL.w0)
+    assert s["distortion"]["detected"] is True and s["realisations"] == 4
+    assert s["distortion"]["statistic"] == pytest.approx(d.statistic, rel=1e-12)
+    # the default rows: the excited band K+1 .. 60 + K of every realisation, noise + distortion weighted
+    ref = lptv.identify(d.experiments(), na=1, nb=0, ka=1, kb=1, lines=[np.arange(2, 62)] * 4)
+    model = lptv.Model.load(out / "model.json")
+    assert np.allclose(model.a, ref.model.a, rtol=1e-9, atol=1e-12)
+    assert np.allclose(model.b, ref.model.b, rtol=1e-9, atol=1e-12)
+    html = (out / "report.html").read_text()
+    assert "distortion.png" in html and (out / "distortion.png").stat().st_size > 1000
+
+
+def test_identify_file_of_realisations_without_distortion(tmp_path, capsys):
+    src = tmp_path / "lin.npz"
+    _record(src, cubic=0.0, seed=3)
+    out = tmp_path / "out"
+    assert cli.main(["identify", str(src), *ARGS, "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "nonlinear distortion not detected" in printed
+    s = json.loads((out / "summary.json").read_text())
+    assert s["distortion"]["detected"] is False
+    assert s["model_ok"] is True, s["verdict"]
+
+
+def test_reader_takes_realisations_only_when_asked(tmp_path):
+    src = tmp_path / "rig.npz"
+    u, y = _record(src, cubic=0.0, M=3, P=4, N=64)
+    with pytest.raises(FileError, match="M realisations x P periods x N samples.*realisations=True"):
+        lptv.read_measurements(src)
+    m = lptv.read_measurements(src, realisations=True, skip_periods=1)
+    assert m.u.shape == (3, 3, 64) and m.realisations == 3
+    assert np.array_equal(m.u, u[:, 1:]) and np.array_equal(m.y, y[:, 1:])
+    assert lptv.read_measurements(tmp_path / "rig.npz", realisations=True).realisations == 3
+    np.savez(tmp_path / "one.npz", u=u[:1], y=y[:1], w0=MODEL.w0)
+    with pytest.raises(FileError, match="at least 2 are needed"):
+        lptv.read_measurements(tmp_path / "one.npz", realisations=True)
+    np.savez(tmp_path / "bad.npz", u=u, y=y[:, :, :60], w0=MODEL.w0)
+    with pytest.raises(FileError, match="realisations x periods x samples"):
+        lptv.read_measurements(tmp_path / "bad.npz", realisations=True)
+
+
+def test_other_commands_refuse_realisations_with_one_line(tmp_path, capsys):
+    src = tmp_path / "rig.npz"
+    _record(src, cubic=0.0, M=3, P=4, N=64)
+    rc = cli.main(["identify", str(src), str(src), *ARGS, "--joint", "--out", str(tmp_path / "j")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "lptv identify FILE given alone" in err and len(err.strip().splitlines()) == 1
