@@ -447,11 +447,22 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
         fig = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     model = res.model
+    from .identify import excited_rows
+
+    def excited_only(d, rows):
+        # Y/U is the FRF only where the input is excited: the verdict's rows also hold the +-K
+        # sidebands of an LPTV model, where U is noise and Y/U means nothing.
+        try:
+            keep = rows[np.isin(rows, excited_rows(d, 0))]
+        except ValueError:
+            return rows
+        return keep if keep.size else rows
+
     if res.data is not None:
-        sets = [("measured Y/U (+-2 std)", res.data, np.asarray(res.verdict_lines))]
+        sets = [("measured Y/U (+-2 std)", res.data, excited_only(res.data, np.asarray(res.verdict_lines)))]
     else:  # several experiments: each one's measured FRF on its own excited lines
         mask, exp = res.verdict_mask, np.asarray(res.experiment)
-        sets = [(f"experiment {e} Y/U (+-2 std)", d, res.lines[mask & (exp == e)])
+        sets = [(f"experiment {e} Y/U (+-2 std)", d, excited_only(d, res.lines[mask & (exp == e)]))
                 for e, d in enumerate(res.experiments)]
         sets = [s for s in sets if s[2].size]
     all_lines = np.concatenate([s[2] for s in sets])

@@ -270,6 +270,25 @@ def test_bode_of_several_experiments_draws_each_record_on_its_excited_lines():
         assert np.allclose(ydb, 20 * np.log10(np.abs(d.Y[rows] / d.U[rows])))
 
 
+def test_bode_of_an_lptv_fit_draws_the_excited_lines_only():
+    """An LPTV fit's verdict rows hold the +-K sidebands of the excited lines, where the input is
+    noise: the measured FRF Y / U is drawn on the excited lines alone (one data set and several)."""
+    pytest.importorskip("matplotlib")
+    from lptv import plots
+    from lptv.examples import paper_measurements
+
+    m = paper_measurements(seed=3, periods=4)
+    excited = np.arange(10, 241, 10)
+    one = lptv.identify(m["u"], m["y"], na=2, nb=1, ka=3, kb=3, w0=m["w0"], lines=range(1, 244))
+    both = lptv.identify([(m["u"], m["y"]), (m["u"][:3], m["y"][:3])], na=2, nb=1, ka=3, kb=3, w0=m["w0"],
+                         lines=[range(1, 244)] * 2)
+    for res in (one, both):
+        assert np.setdiff1d(res.verdict_lines, excited).size > 0     # the sidebands are verdict rows
+        for c in plots.bode(res).axes[0].containers:
+            x, _ = c.lines[0].get_data()
+            assert np.array_equal(np.round(x / m["w0"]).astype(int), excited)
+
+
 # ------------------------------------------------------------------ Cramer-Rao bound, several
 
 @pytest.mark.parametrize("domain", ["ct", "dt"])
