@@ -196,11 +196,12 @@ __attribute__((always_inline)) inline double floor_solve_impl(const FloorData& d
   return best;
 }
 
-__attribute__((noinline)) double floor_scalar(const FloorData& d, const kcd* u, const kcd* corner, kcd* Uf,
+// no-tree-loop-distribute-patterns: the window's moves stay moves, not calls to memmove.
+__attribute__((noinline, optimize("no-tree-loop-distribute-patterns"))) double floor_scalar(const FloorData& d, const kcd* u, const kcd* corner, kcd* Uf,
                                               kcd* z, kcd* y) {
   return floor_solve_impl<false>(d, u, corner, Uf, z, y);
 }
-__attribute__((noinline, target("avx2"), flatten)) double floor_avx2(const FloorData& d, const kcd* u,
+__attribute__((noinline, target("avx2"), flatten, optimize("no-tree-loop-distribute-patterns"))) double floor_avx2(const FloorData& d, const kcd* u,
                                                                      const kcd* corner, kcd* Uf, kcd* z, kcd* y) {
   return floor_solve_impl<true>(d, u, corner, Uf, z, y);
 }
