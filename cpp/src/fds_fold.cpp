@@ -276,7 +276,7 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
 
   FoldedSolution out;
   if (!full) out.Y.resize(L + 1, nu);
-  double best = -1.0;
+  double best = -1.0, peak2 = 0.0;
   int at = 0;
   for (int l = 0; l <= L; ++l) {
     const cd* zl = &z[static_cast<size_t>(L - l) * nz];
@@ -285,9 +285,14 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
     } else {
       for (int q = 0; q < nu; ++q) out.Y(l, q) = zl[q];
     }
+    for (int q = 0; q < nu; ++q) {
+      const double y2 = zl[q].real() * zl[q].real() + zl[q].imag() * zl[q].imag();
+      peak2 = (y2 > peak2 || !(y2 == y2)) && peak2 == peak2 ? y2 : peak2;  // a NaN stays
+    }
     const double a = std::norm(zl[nu]);
     if (a > best || !(a == a)) best = a, at = l;
   }
+  out.peak2 = peak2;
   out.where = L + at;
   out.condition = std::abs(z[static_cast<size_t>(L - at) * nz + nu]);
   return out;
