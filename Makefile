@@ -213,6 +213,7 @@ bench-run:
 	@echo "commit: $$(git rev-parse --short HEAD)$$(git diff --quiet HEAD -- cpp python CMakeLists.txt || echo ' (with uncommitted changes in cpp/, python/ or CMakeLists.txt)')" | tee -a $(BENCH_OUT)/machine.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_fds_cvode 1 | tee $(BENCH_OUT)/fds_cvode.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_fds_scaling $(BENCH_MAX_LINES) | tee $(BENCH_OUT)/fds_scaling.txt
+	set -o pipefail; ./$(BENCH_BIN)/bench_fds_floor 1001 10001 100001 1000001 | tee $(BENCH_OUT)/fds_floor.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_fds_many_inputs | tee $(BENCH_OUT)/fds_many_inputs.txt
 	set -o pipefail; $(PY) bench/python/bench_simulate.py $(BENCH_PY_MAX_LINES) | tee $(BENCH_OUT)/simulate.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_wgtls | tee $(BENCH_OUT)/wgtls.txt

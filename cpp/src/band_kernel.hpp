@@ -295,15 +295,23 @@ void factor_band(Source& src, int n, int Krt, int nz, BandFactors& f, bool keep_
       const kcd l = plain ? kcd((r.real() * pa + r.imag() * pb) * id, (r.imag() * pa - r.real() * pb) * id)
                           : cmul(r, inv);
       if (keep_L) f.L[static_cast<size_t>(k) * K + (i - 1)] = l;
-      // Eliminate column k and shift the row one column left (the window moves with k).
+      // Eliminate column k and shift the row one column left (the window moves with k). A
+      // pivot row that is not long is zero beyond column K: there the row's entries only move
+      // (r - l 0 is r).
       kcd* zr = zrow(slot(i));
-      if constexpr (V) {  // W - 1 = 2K entries: pairs
-        for (int j = 1; j < W; j += 2) store2(R + j - 1, cmsub2(load2(R + j), l, load2(P + j)));
+      const int reach = long_row ? W - 1 : K;  // the pivot row's last nonzero entry
+      if constexpr (V) {  // pairs
+        int j = 1;
+        for (; j + 1 <= reach; j += 2) store2(R + j - 1, cmsub2(load2(R + j), l, load2(P + j)));
+        if (j <= reach) R[j - 1] = cmsub(R[j], l, P[j]), ++j;
+        for (; j + 1 < W; j += 2) store2(R + j - 1, load2(R + j));
+        if (j < W) R[j - 1] = R[j];
         int c = 0;
         for (; c + 1 < nz; c += 2) store2(zr + c, cmsub2(load2(zr + c), l, load2(zp + c)));
         if (c < nz) zr[c] = cmsub(zr[c], l, zp[c]);
       } else {
-        for (int j = 1; j < W; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
+        for (int j = 1; j <= reach; ++j) R[j - 1] = cmsub(R[j], l, P[j]);
+        for (int j = reach + 1; j < W; ++j) R[j - 1] = R[j];
         for (int c = 0; c < nz; ++c) zr[c] = cmsub(zr[c], l, zp[c]);
       }
       R[W - 1] = kcd(0.0, 0.0);

@@ -93,9 +93,11 @@ inline void real_powers(double w, int order, double* t) {
   for (int n = 1; n <= order; ++n) t[n] = t[n - 1] * w;
 }
 
+// t[0] = 1 (real_powers): the sum starts at cj[0], the same number as 0 + cj[0] 1 (an exact
+// zero may differ in sign), one product and one sum fewer per part.
 inline cd band_entry_ct(const cd* cj, const double* t, int order) {
-  double re = 0.0, im = 0.0;
-  for (int n = 0; n <= order; ++n) {
+  double re = cj[0].real(), im = cj[0].imag();
+  for (int n = 1; n <= order; ++n) {
     re += cj[n].real() * t[n];
     im += cj[n].imag() * t[n];
   }

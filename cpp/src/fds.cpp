@@ -337,7 +337,9 @@ detail::FoldedSolution solve_half(const Model& m, const Grid& g, const detail::H
   } catch (const detail::ZeroPivot& e) {
     zero_pivot(e.column, label);
   }
-  if (!(full ? full->allFinite() : r.Y.allFinite())) throw NumericalError("band solve produced NaN or inf");
+  // A finite peak2 is a finite solution; otherwise look (a square may overflow a finite Y).
+  if (!std::isfinite(r.peak2) && !(full ? full->allFinite() : r.Y.allFinite()))
+    throw NumericalError("band solve produced NaN or inf");
   check_condition(r.condition, r.where, label);
   return r;
 }
@@ -453,6 +455,7 @@ double max_abs(const Eigen::MatrixXcd& x) {
 void check_input(const Eigen::MatrixXcd& U) {
   if (U.rows() < 1 || U.cols() < 1) throw std::invalid_argument("U must not be empty");
   if (!U.allFinite()) throw std::invalid_argument("U contains NaN or inf");
+  if (U.row(0).imag().isZero(0.0)) return;  // the usual real DC line: no scale needed
   const double scale = std::max(max_abs(U), 1e-300);
   for (Eigen::Index j = 0; j < U.cols(); ++j) {
     if (std::abs(U(0, j).imag()) > 1e-12 * scale) {
@@ -616,7 +619,8 @@ SimulateResult simulate(const Model& m, const Eigen::MatrixXcd& U, const Simulat
     if (half && detail::can_fold(m, g)) {
       detail::FoldedSolution s = solve_half(m, g, U.topRows(std::min<Eigen::Index>(U.rows(), g.L + 1)));
       res.solver = Solver::Band;
-      const double peak = std::max(max_abs(s.Y), 1e-300);
+      // max_abs(s.Y): the square root of the largest |y|^2, here from the solve's own pass.
+      const double peak = std::max(std::isfinite(s.peak2) ? std::sqrt(s.peak2) : max_abs(s.Y), 1e-300);
       double edge = 0;
       for (int l = std::max(0, g.L - K + 1); l <= g.L; ++l) edge = std::max(edge, s.Y.row(l).cwiseAbs().maxCoeff());
       const double cond = std::max(1.0, s.condition);

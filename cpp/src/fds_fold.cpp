@@ -19,7 +19,9 @@ namespace {
 // band_entry_ct: the same numbers as build_A's band_entry.
 // Right-hand sides of a row: (B U)_l for each column of U, summed in the full grid's order
 // (U_{-l} = conj(U_l)), then the check's entry m_l exp(j g l).
-template <int NA>  // the order na as a constant (with nb <= na), or -1: any orders
+// NA, NB: the orders na and nb as constants (or -1: any); KT: K = Ka as a constant (or -1), so
+// that the sums over orders and the entries of a row unroll (the same sums).
+template <int NA, int NB, int KT>
 class FoldedRows {
  public:
   FoldedRows(const Model& m, const Grid& g, const HalfInput& U)
@@ -40,26 +42,28 @@ class FoldedRows {
   }
   int columns() const { return nrhs_ + 1; }
   int na() const { return NA >= 0 ? NA : na_; }
-  int P() const { return NA >= 0 ? NA + 1 : P_; }
+  int nb() const { return NB >= 0 ? NB : nb_; }
+  int K() const { return KT >= 0 ? KT : K_; }
+  int P() const { return NA >= 0 ? NA + 1 : P_; }  // nb <= na when NA >= 0
 
   // A(l, i) for the line l of reversed row r and the lines i of reversed columns base..base+2K.
   __attribute__((always_inline)) void row(int r, int base, cd* out) {
     const int l = L_ - r;
     ensure(l - Km_);
     const cd* a = aj_.data();
-    const int n = na();
-    if (l + K_ <= L_ && base == L_ - l - K_) {
+    const int n = na(), K = this->K();
+    if (l + K <= L_ && base == L_ - l - K) {
       // Rows whose band lies inside the grid (all but the top K): no bounds to test, the
       // entry j in column line l + K - j.
-      for (int j = 0; j <= 2 * K_; ++j)
-        out[j] = band_entry_ct(a + static_cast<size_t>(j) * (n + 1), t(l + K_ - j), n);
+      for (int j = 0; j <= 2 * K; ++j)
+        out[j] = band_entry_ct(a + static_cast<size_t>(j) * (n + 1), t(l + K - j), n);
       return;
     }
-    for (int j = 0; j <= 2 * K_; ++j) {
+    for (int j = 0; j <= 2 * K; ++j) {
       const int i = L_ - base - j;
-      out[j] = (i < 0 || i > L_ || std::abs(l - i) > K_)
+      out[j] = (i < 0 || i > L_ || std::abs(l - i) > K)
                    ? cd(0.0, 0.0)
-                   : band_entry_ct(a + static_cast<size_t>(K_ + l - i) * (n + 1), t(i), n);
+                   : band_entry_ct(a + static_cast<size_t>(K + l - i) * (n + 1), t(i), n);
     }
   }
   // A(l, i) for |l - i| <= K, any line i of the grid (negative lines too).
@@ -72,6 +76,7 @@ class FoldedRows {
     const int l = L_ - r;
     ensure(l - Km_);
     const cd* b = bj_.data();
+    const int nb = this->nb();
     const int lo = std::max(-L_, l - Kb_), hi = std::min(L_, l + Kb_);
     for (int q = 0; q < nrhs_; ++q) {
       const cd* u = U_.col(q).data();  // line i >= 0; conj(u[-i]) for i < 0
@@ -79,7 +84,7 @@ class FoldedRows {
       if (lo >= 0) {  // no conjugate lines in this row
         for (int c = lo; c <= hi; ++c) {
           if (!nonzero_[c]) continue;
-          const cd v = band_entry_ct(b + static_cast<size_t>(Kb_ + l - c) * (nb_ + 1), t(c), nb_);
+          const cd v = band_entry_ct(b + static_cast<size_t>(Kb_ + l - c) * (nb + 1), t(c), nb);
           re += v.real() * u[c].real() - v.imag() * u[c].imag();
           im += v.real() * u[c].imag() + v.imag() * u[c].real();
         }
@@ -90,7 +95,7 @@ class FoldedRows {
         const int a = c < 0 ? -c : c;
         if (!nonzero_[a]) continue;
         const cd uc = c < 0 ? std::conj(u[a]) : u[a];
-        const cd v = band_entry_ct(b + static_cast<size_t>(Kb_ + l - c) * (nb_ + 1), t(c), nb_);
+        const cd v = band_entry_ct(b + static_cast<size_t>(Kb_ + l - c) * (nb + 1), t(c), nb);
         re += v.real() * uc.real() - v.imag() * uc.imag();
         im += v.real() * uc.imag() + v.imag() * uc.real();
       }
@@ -224,10 +229,10 @@ bool real_input(const Grid& g, const Eigen::MatrixXcd& U_full) {
 
 namespace {
 
-template <int NA>
+template <int NA, int NB, int KT>
 FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U, Eigen::MatrixXcd* full) {
   const int L = g.L, K = m.ka(), W = 2 * K + 1;
-  FoldedRows<NA> src(m, g, U);
+  FoldedRows<NA, NB, KT> src(m, g, U);
   const int nz = src.columns(), nu = nz - 1;
   // Columns Y_L..Y_2K by the band kernel: rows L..K enter.
   const int steps = L - 2 * K + 1;
@@ -236,9 +241,7 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
   RawArray z;
   z.resize(static_cast<size_t>(L + 1) * nz);  // rows steps..L: Y_2K-1..Y_0 from the corner
   try {
-    dispatch_band(K, [&](auto kt) {
-      factor_band_best<decltype(kt)::value>(src, L + 1, K, nz, f, false, z.data(), steps, &tail);
-    });
+    factor_band_best<KT>(src, L + 1, K, nz, f, false, z.data(), steps, &tail);
   } catch (const ZeroPivot& e) {
     throw ZeroPivot{L + (L - e.column)};
   }
@@ -269,11 +272,11 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
     for (int q = 0; q < nz; ++q)
       zi[q] = i == 0 ? cd(y(0, q), 0.0) : cd(y(2 * i - 1, q), y(2 * i, q));
   }
-  dispatch_band(K, [&](auto kt) { back_substitute_best<decltype(kt)::value>(f, nz, z.data()); });
+  back_substitute_best<KT>(f, nz, z.data());
 
   FoldedSolution out;
   if (!full) out.Y.resize(L + 1, nu);
-  double best = -1.0;
+  double best = -1.0, peak2 = 0.0;
   int at = 0;
   for (int l = 0; l <= L; ++l) {
     const cd* zl = &z[static_cast<size_t>(L - l) * nz];
@@ -282,27 +285,49 @@ FoldedSolution solve_folded_as(const Model& m, const Grid& g, const HalfInput& U
     } else {
       for (int q = 0; q < nu; ++q) out.Y(l, q) = zl[q];
     }
+    for (int q = 0; q < nu; ++q) {
+      const double y2 = zl[q].real() * zl[q].real() + zl[q].imag() * zl[q].imag();
+      peak2 = (y2 > peak2 || !(y2 == y2)) && peak2 == peak2 ? y2 : peak2;  // a NaN stays
+    }
     const double a = std::norm(zl[nu]);
     if (a > best || !(a == a)) best = a, at = l;
   }
+  out.peak2 = peak2;
   out.where = L + at;
   out.condition = std::abs(z[static_cast<size_t>(L - at) * nz + nu]);
   return out;
 }
 
+template <int NA, int NB>
+FoldedSolution solve_folded_orders(const Model& m, const Grid& g, const HalfInput& U, Eigen::MatrixXcd* full) {
+  return dispatch_band(m.ka(), [&](auto kt) {
+    constexpr int KT = decltype(kt)::value;  // K >= 1 here (can_fold): no instance for K = 0
+    return solve_folded_as<NA, NB, KT == 0 ? -1 : KT>(m, g, U, full);
+  });
+}
+
 }  // namespace
 
 FoldedSolution solve_folded(const Model& m, const Grid& g, const HalfInput& U, Eigen::MatrixXcd* full) {
-  // The orders as constants for the common models, so that the sums unroll (the same sums).
-  if (m.nb() <= m.na()) {
-    switch (m.na()) {
-      case 1: return solve_folded_as<1>(m, g, U, full);
-      case 2: return solve_folded_as<2>(m, g, U, full);
-      case 3: return solve_folded_as<3>(m, g, U, full);
+  // The orders and K as constants for the common models, so that the sums and the rows unroll
+  // (the same sums): na = 1..3 with nb = na - 1 or na; na alone for a smaller nb.
+  const int na = m.na(), nb = m.nb();
+  if (nb <= na && na >= 1 && na <= 3) {
+    switch (4 * na + nb) {
+      case 4: return solve_folded_orders<1, 0>(m, g, U, full);
+      case 5: return solve_folded_orders<1, 1>(m, g, U, full);
+      case 9: return solve_folded_orders<2, 1>(m, g, U, full);
+      case 10: return solve_folded_orders<2, 2>(m, g, U, full);
+      case 14: return solve_folded_orders<3, 2>(m, g, U, full);
+      case 15: return solve_folded_orders<3, 3>(m, g, U, full);
       default: break;
     }
+    switch (na) {
+      case 2: return solve_folded_orders<2, -1>(m, g, U, full);
+      default: return solve_folded_orders<3, -1>(m, g, U, full);
+    }
   }
-  return solve_folded_as<-1>(m, g, U, full);
+  return solve_folded_orders<-1, -1>(m, g, U, full);
 }
 
 }  // namespace detail

@@ -97,6 +97,10 @@ struct FoldedSolution {
   Eigen::MatrixXcd Y;      // lines 0..L (the negative lines are their conjugates); empty with `full`
   double condition = 0.0;  // max |x| of the check's solution
   int where = 0;           // its grid index (a line >= 0)
+  // max |Y_lq|^2 over the solution (re^2 + im^2, as Eigen's abs2), NaN or inf where Y has a NaN
+  // or an inf (or where a square overflows): taken in the pass that writes Y, so that the
+  // caller's size and finiteness checks need no pass of their own.
+  double peak2 = 0.0;
 };
 
 // Y = A^-1 B U on the grid with the check. Throws ZeroPivot (band_kernel.hpp) with the grid
