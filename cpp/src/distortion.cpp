@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "lptv/errors.hpp"
+
 namespace lptv {
 
 namespace {
@@ -136,6 +138,13 @@ DistortionLines distortion_lines(const DistortionInput& in) {
         if (c == j) v -= 2.0 * (std::conj(G[a]) * in.covYU(m, j)).real();
       }
       nv += v;
+    }
+    bool finite = std::isfinite(s2) && std::isfinite(nv) && G.allFinite();
+    for (int a = 0; a < q; ++a) finite = finite && std::isfinite(Cinv(a, 0) * s2);
+    if (!finite) {
+      throw NumericalError("distortion_lines: the regression of line " + std::to_string(j) +
+                           " overflowed (the spectra or variances span too many orders of magnitude): "
+                           "scale U and Y");
     }
     out.total[i] = s2;
     out.noise[i] = nv / M;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "lptv/distortion.hpp"
+#include "lptv/errors.hpp"
 
 using cd = std::complex<double>;
 
@@ -156,4 +157,14 @@ TEST_CASE("Distortion: bad input names the argument", "[distortion]") {
   x = in;
   x.branches = 5;
   fails(x, "branches must be within 0..4");
+}
+
+TEST_CASE("Distortion: overflow is a NumericalError naming the line", "[distortion]") {
+  // U_1 = 1e-300, Y_1 = 1e100: G = 1e400 is not a double.
+  lptv::DistortionInput in = zeros(3, 2);
+  in.excited = {1};
+  in.U.col(1) << 1e-300, 2e-300, 1e-300;
+  in.Y.col(1) << 1e100, -1e100, 3e100;
+  REQUIRE_THROWS_WITH(lptv::distortion_lines(in), Catch::Contains("regression of line 1 overflowed"));
+  REQUIRE_THROWS_AS(lptv::distortion_lines(in), lptv::NumericalError);
 }

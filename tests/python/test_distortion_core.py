@@ -5,12 +5,16 @@ lptv.distortion as a whole against the reference on spectra from numpy.fft. Tole
 (DISTORTION_VS_REFERENCE), scaled per line by the conditioning of its regression."""
 import numpy as np
 import pytest
+from hypothesis import event, given
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
 
 import lptv
 from lptv import _core
 from lptv.reference import distortion as ref
 from lptv.reference.identification import frequency_data
 from conftest import DISTORTION_KAPPA_MAX, DISTORTION_RELATIVE, DISTORTION_VS_REFERENCE as TOL
+from test_bindings_hypothesis import ACCEPTED, FUZZ
 from test_distortion import _realisations
 
 CASES = [("paper", 4, 0, 0.0), ("paper", 4, 1, 0.0), ("paper", 4, 2, 0.02), ("paper", 8, 3, 0.02),
@@ -156,3 +160,39 @@ def test_bad_inputs_name_the_argument():
     for change, msg in cases:
         with pytest.raises(ValueError, match=msg):
             _core.distortion_lines(**{**good, **change})
+
+
+@FUZZ
+@given(M=st.integers(1, 6), L=st.integers(0, 12), data=st.data(),
+       excited=st.lists(st.integers(-2, 14), max_size=4), branches=st.integers(-2, 14))
+def test_random_inputs_give_a_result_or_value_error(M, L, data, excited, branches):
+    """Random sizes, lines and values (now and then NaN, inf or a negative variance; magnitudes
+    from subnormal to 1e100): the core either returns finite numbers wherever a line has a
+    residual degree of freedom, with the reference's degrees of freedom, or raises ValueError
+    (bad input) or NumericalError (a regression that overflows)."""
+    def arr(dtype, nonneg=False):
+        el = st.floats(0 if nonneg else -1e100, 1e100)
+        x = data.draw(hnp.arrays(float, (M, L + 1), elements=el)).astype(dtype)
+        if dtype is complex:
+            x.imag = data.draw(hnp.arrays(float, (M, L + 1), elements=el))
+        if x.size and data.draw(st.integers(0, 19)) == 0:   # now and then one bad value
+            x.flat[data.draw(st.integers(0, x.size - 1))] = data.draw(st.sampled_from([np.nan, np.inf, -1.0]))
+        return x
+    args = (arr(complex), arr(complex), arr(float, True), arr(float, True), arr(complex), excited, branches)
+    valid = sorted(set(e for e in excited if 1 <= e <= L))
+    if valid and data.draw(st.integers(0, 3)) > 0:   # mostly lines and Kh that fit
+        args = args[:5] + (valid, abs(branches) % (L + 1))
+    try:
+        d = _core.distortion_lines(*args)
+    except ACCEPTED as e:
+        event(type(e).__name__)
+        return
+    event("result")
+    assert M >= 2 and L >= 1
+    ok = np.asarray(d.dof) >= 1
+    for name in ("total", "noise"):
+        assert np.all(np.isfinite(np.asarray(getattr(d, name))[ok])), name
+    assert np.all(np.isfinite(np.asarray(d.signal)))
+    with np.errstate(all="ignore"):
+        r = ref.distortion_lines(*args)
+    np.testing.assert_array_equal(np.asarray(d.dof), r.dof)

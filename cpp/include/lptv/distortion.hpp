@@ -42,7 +42,8 @@ struct DistortionLines {
 // finite, variances are negative, the excited lines are empty, unsorted, repeated or outside
 // 1..L, or branches is negative or above L. A rank-deficient regression (realisations whose
 // excited lines are proportional) gets the minimum-norm solution and the pseudo-inverse, with
-// the cut-offs of numpy.linalg.lstsq and numpy.linalg.pinv.
+// the cut-offs of numpy.linalg.lstsq and numpy.linalg.pinv. Throws NumericalError naming the
+// line where the regression overflows (magnitudes near the ends of the double range).
 DistortionLines distortion_lines(const DistortionInput& in);
 
 }  // namespace lptv
