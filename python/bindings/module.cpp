@@ -23,5 +23,6 @@ PYBIND11_MODULE(_core, m) {
   bind_likelihood(m);
   bind_estimators(m);
   bind_htf_estimate(m);
+  bind_distortion(m);
   bind_floquet(m);
 }

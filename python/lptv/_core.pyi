@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -392,6 +392,43 @@ class HtfEstimate:
     @property
     def variance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
+class DistortionLines:
+    """
+    Per output line: the regression of the realisations' Y_j on the excited lines within +-Kh (lptv::distortion_lines).
+    """
+    @property
+    def bla(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
+    @property
+    def bla_var(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def branches(self) -> int:
+        ...
+    @property
+    def dof(self) -> typing.Annotated[numpy.typing.NDArray[numpy.int32], "[m, 1]"]:
+        ...
+    @property
+    def excited(self) -> list[int]:
+        ...
+    @property
+    def lines(self) -> list[int]:
+        ...
+    @property
+    def noise(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def realisations(self) -> int:
+        ...
+    @property
+    def regressors(self) -> typing.Annotated[numpy.typing.NDArray[numpy.int32], "[m, 1]"]:
+        ...
+    @property
+    def signal(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def total(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 class Floquet:
     """
     Characteristic multipliers and Floquet exponents (lptv::floquet).
@@ -442,6 +479,27 @@ def default_solver(discrete: bool = False) -> str:
 def diagnose_data(data: FrequencyData, structure: Structure, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], check_row_count: bool = True) -> DataDiagnosis:
     """
     The data diagnostics lptv::identify runs first: raises ValueError naming the argument and the cause for degenerate data (METHOD.md section 15).
+    """
+def distortion_lines(U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], varU: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], varY: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], covYU: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], excited: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], branches: typing.SupportsInt | typing.SupportsIndex) -> DistortionLines:
+    """
+    Noise, residual variance and BLA per output line from M random-phase realisations.
+    
+    Parameters
+    ----------
+    U, Y : ndarray, shape (M, L + 1), complex
+        Period-mean spectra of each realisation on lines 0..L.
+    varU, varY : ndarray, shape (M, L + 1), float
+        Noise variances of those means.
+    covYU : ndarray, shape (M, L + 1), complex
+        E{dY conj(dU)} of the means.
+    excited : list of int
+        Excited lines, ascending, within 1..L.
+    branches : int
+        Kh: line j regresses on the excited lines c (and conjugates -c) with |j - c| <= Kh.
+    
+    Returns
+    -------
+    DistortionLines
     """
 def estimate(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50) -> EstimateResult:
     ...

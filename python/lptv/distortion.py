@@ -19,6 +19,10 @@ difference estimates the nonlinear level. The regression coefficients are the be
 time-periodic approximation (BLA) of the HTF branches, with their total covariance (noise and
 nonlinear distortion) s_j^2 (X^H X)^-1; overlapping branches of neighbouring excited lines are
 estimated jointly rather than leaking into each other.
+
+The per-line regression runs in the compiled core (``_core.distortion_lines``; its NumPy
+twin is :mod:`lptv.reference.distortion`); the spectra, the excited lines and Kh come before it,
+the F tests and the overall statistic (SciPy) after it, here.
 """
 from __future__ import annotations
 
@@ -267,43 +271,11 @@ def distortion(u, y, *, w0: float, ts: Optional[float] = None, branches: Optiona
         Kh = _default_branches(src, lines, spacing, M)
     else:
         Kh = as_int(branches, "branches", maximum=L)
-    Ufull = lambda c: U[:, c] if c >= 0 else np.conj(U[:, -c])           # noqa: E731
+    core = _core.distortion_lines(U, Y, varU, varY, cov, [int(c) for c in excited], Kh)
+    total, noise = np.array(core.total), np.array(core.noise)      # copies: the result's own arrays
+    dof = np.array(core.dof, dtype=int)
+    bla, bla_var = np.array(core.bla), np.array(core.bla_var)
     n = lines.size
-    total = np.full(n, np.nan)
-    noise = np.full(n, np.nan)
-    dof = np.zeros(n, int)
-    bla = np.full((2 * Kh + 1, excited.size), np.nan + 0j)
-    bla_var = np.full((2 * Kh + 1, excited.size), np.nan)
-    ex_index = {int(c): i for i, c in enumerate(excited)}
-    for i, j in enumerate(lines):
-        cs = src[np.abs(j - src) <= Kh]
-        q = cs.size
-        dof[i] = M - q
-        if M - q < 1:
-            continue
-        yj = Y[:, j]
-        if q:
-            X = np.column_stack([Ufull(int(c)) for c in cs])        # (M, q)
-            G, *_ = np.linalg.lstsq(X, yj, rcond=None)
-            r = yj - X @ G
-        else:
-            X, G, r = None, np.zeros(0, complex), yj - 0.0
-        s2 = float(np.sum(np.abs(r) ** 2) / (M - q))
-        # noise of one realisation's period mean: output, plus the input noise through G
-        nv = varY[:, j].copy()
-        for g, c in zip(G, cs):
-            c = int(c)
-            nv = nv + np.abs(g) ** 2 * varU[:, abs(c)]
-            if c == j:
-                nv = nv - 2 * np.real(np.conj(g) * cov[:, j])
-        total[i], noise[i] = s2, float(np.mean(nv))
-        if q:
-            Ci = np.linalg.pinv(X.conj().T @ X)
-            for g, c, v in zip(G, cs, np.real(np.diag(Ci)) * s2):
-                c = int(c)
-                if c > 0:
-                    bla[Kh + (j - c), ex_index[c]] = g
-                    bla_var[Kh + (j - c), ex_index[c]] = v
     from scipy import stats
 
     ok = dof >= 1
@@ -324,7 +296,7 @@ def distortion(u, y, *, w0: float, ts: Optional[float] = None, branches: Optiona
         near |= np.abs(lines - c) <= Kh
     kind[near] = "sideband"
     kind[np.isin(lines, excited)] = "excited"
-    signal = np.mean(np.abs(Y[:, 1:]) ** 2, axis=0)
+    signal = np.array(core.signal)
     return DistortionResult(
         lines=lines, w=lines * w0, kind=kind.astype(str), signal=signal, noise=noise, total=total,
         nonlinear=nl, nonlinear_std=nl_std, p_value=p, dof=dof, excited=excited, branches=Kh,

@@ -8,9 +8,11 @@ It reads a model's coefficient arrays and never calls the core's computations.
   covariance, LS / TLS / GTLS / WGTLS;
 - :mod:`lptv.reference.likelihood`: the exact likelihood of LPTV rows (real noise vector,
   residue covariance S, cost r^T S^-1 r and its gradient), its minimiser and the Cramer-Rao
-  bound, all dense.
+  bound, all dense;
+- :mod:`lptv.reference.distortion`: the regression of random-phase realisations per output line
+  behind :func:`lptv.distortion` (residual and noise variances, the BLA and its variance).
 """
-from . import excitation, identification, likelihood
+from . import distortion, excitation, identification, likelihood
 from .fds import (
     band_matrix_A,
     band_matrix_B,
@@ -28,7 +30,7 @@ from .fds import (
 )
 
 __all__ = [
-    "excitation", "identification", "likelihood", "band_matrix_A", "band_matrix_B", "coefficients_at",
+    "distortion", "excitation", "identification", "likelihood", "band_matrix_A", "band_matrix_B", "coefficients_at",
     "crest_factor", "full_spectrum", "grid", "htf", "line_variable", "multisine_spectrum",
     "samples_per_period", "simulate", "spectrum", "time_signal",
 ]
