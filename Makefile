@@ -217,6 +217,7 @@ bench-run:
 	set -o pipefail; ./$(BENCH_BIN)/bench_fds_many_inputs | tee $(BENCH_OUT)/fds_many_inputs.txt
 	set -o pipefail; $(PY) bench/python/bench_simulate.py $(BENCH_PY_MAX_LINES) | tee $(BENCH_OUT)/simulate.txt
 	set -o pipefail; ./$(BENCH_BIN)/bench_wgtls | tee $(BENCH_OUT)/wgtls.txt
+	set -o pipefail; ./$(BENCH_BIN)/bench_estimate_floor | tee $(BENCH_OUT)/estimate_floor.txt
 	set -o pipefail; $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py.txt
 	set -o pipefail; OPENBLAS_NUM_THREADS=1 $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py_1thread.txt
 	set -o pipefail; $(PY) bench/python/bench_sml.py | tee $(BENCH_OUT)/sml.txt
