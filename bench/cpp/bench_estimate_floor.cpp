@@ -15,7 +15,8 @@
 // taking turns, each one's fastest round counting (the least disturbed by other work).
 //
 // Usage: bench_estimate_floor [seeds]   (default 3)
-//        bench_estimate_floor --loop wgtls|sml SECONDS   (one method in a loop, for a profiler)
+//        bench_estimate_floor --loop wgtls|sml SECONDS   (one method in a loop, for a profiler;
+//        --loop identify-wgtls|identify-sml: lptv::identify, with the covariance and diagnostics)
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -116,13 +117,23 @@ int main(int argc, char** argv) {
   for (int l = 1; l <= 243; ++l) rows.push_back(l);
   if (argc > 3 && std::string(argv[1]) == "--loop") {
     const lptv::FrequencyData d = measurements(1);
+    const std::string what = argv[2];
+    const bool whole = what.rfind("identify-", 0) == 0;
     lptv::EstimateOptions o;
-    o.method = lptv::method_from_string(argv[2]);
+    o.method = lptv::method_from_string(whole ? what.substr(9) : what);
     o.tol = 1e-12;
+    lptv::IdentifyOptions io;
+    io.method = o.method;
+    io.tol = o.tol;
+    io.rows = rows;
     const auto t0 = std::chrono::steady_clock::now();
     int n = 0;
     while (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < std::atof(argv[3])) {
-      (void)lptv::estimate(d, p, rows, o);
+      if (whole) {
+        (void)lptv::identify(d, p.structure(), io);
+      } else {
+        (void)lptv::estimate(d, p, rows, o);
+      }
       ++n;
     }
     std::printf("%s: %d fits\n", argv[2], n);
