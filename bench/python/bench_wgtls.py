@@ -27,6 +27,8 @@ slow the reference down. ``make bench`` runs this script twice, as is and with
 OPENBLAS_NUM_THREADS=1 (the reference's faster setting here).
 
 Usage: python bench_wgtls.py [seeds]   (default 3: seeds 1..3)
+       python bench_wgtls.py --phases   (where lptv.identify's time goes, seed 1: its parts
+       wrapped with timers, mean of 200 calls after 20)
 """
 from __future__ import annotations
 
@@ -117,5 +119,58 @@ def main(n_seeds: int = 3):
     print(f"lptv.identify / _core.estimate (goal: <= 1.2x): {min(overhead):.2f}x .. {max(overhead):.2f}x")
 
 
+def phases(n: int = 200):
+    """lptv.identify split into the spectra from the periods, the compiled identify (estimate,
+    covariance, residues, diagnostics), the stability check and the rest; and the estimate alone."""
+    mod = sys.modules["lptv.identify"]
+    m = paper_measurements(1, periods=8)
+    u, y, w0 = m["u"], m["y"], m["w0"]
+    spent = {}
+
+    def timed(name, f):
+        def g(*a, **k):
+            t0 = time.perf_counter()
+            try:
+                return f(*a, **k)
+            finally:
+                spent[name] = spent.get(name, 0.0) + time.perf_counter() - t0
+        return g
+
+    saved = {k: getattr(mod, k) for k in ("frequency_data_of", "stability_check")}
+    saved_core = mod._core.identify
+    mod.frequency_data_of = timed("spectra from the periods", saved["frequency_data_of"])
+    mod.stability_check = timed("stability check", saved["stability_check"])
+    mod._core.identify = timed("_core.identify (estimate, covariance, residues)", saved_core)
+    try:
+        call = lambda: lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, tol=TOL)
+        for _ in range(20):
+            call()
+        spent.clear()
+        t0 = time.perf_counter()
+        for _ in range(n):
+            call()
+        total = time.perf_counter() - t0
+    finally:
+        for k, f in saved.items():
+            setattr(mod, k, f)
+        mod._core.identify = saved_core
+    data = FrequencyData.from_periods(u, y, w0=w0)
+    par = _core.Parametrisation(NA, NB, [K] * (NA + 1), [K] * (NB + 1), [], w0, 0.0)
+    rows = list(LINES)
+    t0 = time.perf_counter()
+    for _ in range(n):
+        _core.estimate(data._cpp, par, rows, method="wgtls", tol=TOL, max_iter=50)
+    est = time.perf_counter() - t0
+    print(f"lptv.identify (WGTLS, paper example seed 1, tol {TOL:g}), mean of {n} calls after 20:")
+    print(f"  {'whole call':48s} {1e3 * total / n:7.3f} ms")
+    for k, v in spent.items():
+        print(f"  {k:48s} {1e3 * v / n:7.3f} ms")
+    print(f"  {'the rest (Python)':48s} {1e3 * (total - sum(spent.values())) / n:7.3f} ms")
+    print(f"  {'_core.estimate alone (same data)':48s} {1e3 * est / n:7.3f} ms")
+
+
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
+    if len(sys.argv) > 1 and sys.argv[1] == "--phases":
+        phases()
+    else:
+        main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
