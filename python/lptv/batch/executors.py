@@ -182,8 +182,12 @@ class _Clock:
             _cost[self.key] = self.seconds / self.items
 
 
-def _timed_chunk(items: Sequence, fn: Callable, shared: Any):
-    """:func:`run_chunk` and the seconds it took on the worker."""
+def _timed_chunk(items: Sequence, fn: Callable, shared: Any, cwd: Optional[str] = None):
+    """:func:`run_chunk` and the seconds it took on the worker; in the folder ``cwd`` if given
+    (a kept pool's worker was forked where the caller was then, and relative paths are the
+    caller's)."""
+    if cwd is not None and os.getcwd() != cwd:
+        os.chdir(cwd)
     t0 = time.perf_counter()
     results = run_chunk(items, fn, shared)
     return results, time.perf_counter() - t0
@@ -402,7 +406,8 @@ def _run_futures(fn, items, todo, shared, executor, workers, chunk_size, bar, we
     else:
         pool = executor
     try:
-        futures = {pool.submit(_timed_chunk, [items[i] for i in c], fn, shared): c for c in chunks}
+        cwd = os.getcwd() if kept else None
+        futures = {pool.submit(_timed_chunk, [items[i] for i in c], fn, shared, cwd): c for c in chunks}
         for fut in cf.as_completed(futures):
             c = futures[fut]
             try:

@@ -63,9 +63,12 @@ def warm_up():
 
 
 def _pool_worker_start():
-    from .executors import _ignore_interrupts
+    import signal
 
-    _ignore_interrupts()
+    # Ctrl-C reaches the whole process group: it is the caller's to handle (the worker finishes
+    # its chunk). SIGTERM keeps its default: when a worker dies, the pool terminates the others
+    # (the queue's lock may have died with it, held) and would otherwise wait for them forever.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     warm_up()
 
 
