@@ -10,12 +10,23 @@ that died): the other items still finish.
 Executors (the ``executor`` argument):
 
 - ``"processes"`` (the default): a :class:`concurrent.futures.ProcessPoolExecutor` with
-  ``workers`` processes (default: the cores this process may use), shut down at the end;
+  ``workers`` processes (default: the cores this process may use). lptv's own tasks
+  (``lptv.montecarlo``, ``lptv.identify_many``, ``lptv.select``) run on one pool kept between
+  calls, its workers warm (lptv and scipy.signal imported once), ended at exit or by
+  :func:`lptv.batch.shutdown_pool` (:mod:`lptv.batch.warm`); a function of your own gets a
+  pool per call, shut down at its end;
 - ``"serial"``: in this process, one item after the other;
 - a scheduler address such as ``"tcp://10.0.0.5:8786"``: a :class:`distributed.Client`
-  connected for the run and closed at the end (``pip install 'lptv[batch]'``);
+  connected for the run and closed at the end (``pip install 'lptv[batch]'``); on a cluster
+  (this case or the next) lptv registers a worker plugin that imports lptv and scipy.signal once per worker
+  (:mod:`lptv.batch.dask_plugin`), and where Dask's ``MALLOC_TRIM_THRESHOLD_`` is set its
+  chunks run with glibc's thresholds raised, trimmed after (:func:`lptv.batch.warm.malloc_kept`);
 - a :class:`distributed.Client` (or a :class:`concurrent.futures.Executor`) of your own: used
   as it is and left open, so that several runs share one cluster or one pool.
+
+Chunks: ``chunk_size`` items per task if given; otherwise, once the workers have measured the
+cost of an item on an earlier call of the same function, tasks that shrink from long to short
+(:func:`chunk_sizes`), so that the workers finish together; before that, :func:`default_chunk_size`.
 
 Results do not depend on the executor: the tasks draw their random numbers from seeds handed
 to them (see :func:`lptv.montecarlo`), never from the worker they run on, and they run with
@@ -281,13 +292,15 @@ def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="pr
         Small picklable descriptions of the tasks (an index and a seed, a file name ...).
     shared : object
         What every task needs (the design of a study): sent once per chunk (once per worker
-        on Dask, where it is scattered).
+        on Dask, where it is scattered; pickling the 35 KB design of the paper's example takes
+        0.06 ms, nothing next to a chunk).
     executor : {'processes', 'serial'}, str, distributed.Client or concurrent.futures.Executor
         See the module's description.
     workers : int, optional
         Processes of ``executor='processes'`` (default: the available cores).
     chunk_size : int, optional
-        Items per task (default :func:`default_chunk_size`).
+        Items per task (default: :func:`chunk_sizes` from the cost measured on the last call of
+        ``fn``, :func:`default_chunk_size` before one).
     progress : bool, optional
         Progress bar with an ETA: None shows it when stderr is a terminal.
     desc, unit, weight :
