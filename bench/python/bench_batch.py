@@ -96,24 +96,35 @@ def main():
     print(f"machine: {os.cpu_count()} cores, load average {load()} at the start")
     import dask
 
-    # First: a nanny also writes its pre-spawn environment into this process's os.environ, which
-    # the workers of a later cluster would inherit.
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-        cluster_nt = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  host="127.0.0.1")
-    client_nt = Client(cluster_nt)
-    study(client_nt, 4)
-    t0 = time.perf_counter()
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                           host="127.0.0.1")
-    client = Client(cluster)
-    t_cluster = time.perf_counter() - t0
-    study(client, 4)
+    def start_cluster(trim=True):
+        """A LocalCluster of 2 workers x 1 thread (Dask's default worker environment, or with
+        MALLOC_TRIM_THRESHOLD_ unset) and its client, warmed by a 4-run study. A nanny writes its
+        pre-spawn environment into this process's os.environ, where the process pool's workers
+        would find it: it is put back."""
+        env = dict(os.environ)
+        cfg = {} if trim else {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+        t0 = time.perf_counter()
+        with dask.config.set(cfg):
+            cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   host="127.0.0.1")
+        os.environ.clear()
+        os.environ.update(env)
+        client = Client(cluster)
+        started = time.perf_counter() - t0
+        study(client, 4)
+        return cluster, client, started
+
+    trim = {}
+    for label, flag in (("default", True), ("unset", False)):
+        cluster, client, t_cluster = start_cluster(flag)
+        trim[label] = next(iter(client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values()))
+        client.close()
+        cluster.close()
     study("processes", 4, workers=2)
+    study("serial", 4)
     print(f"Dask LocalCluster (2 workers x 1 thread) started in {t_cluster:.2f} s, warmed by a 4-run study "
-          "(lptv registers its warm-up plugin on the client)")
-    trim = {c: next(iter(cl.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values()))
-            for c, cl in (("default", client), ("unset", client_nt))}
+          "(lptv registers its warm-up plugin on the client); each Dask row starts its cluster before its "
+          "turn and closes it after,\nso that no idle cluster shares the cores with the other rows")
     print(f"MALLOC_TRIM_THRESHOLD_ in the workers: {trim} (lptv raises glibc's thresholds around its "
           "chunks where it is set)")
     print("pool per call: lptv.batch.shutdown_pool() before and after the call, both inside the time "
@@ -122,8 +133,8 @@ def main():
 
     executors = (("serial", "serial", {}, 1), ("2 processes (pool per call)", "processes", {"workers": 2, "per_call": True}, 2),
                  ("2 processes (pool kept)", "processes", {"workers": 2}, 2),
-                 ("Dask LocalCluster 2 workers", client, {}, 2),
-                 ("  the same, malloc trim unset", client_nt, {}, 2))
+                 ("Dask LocalCluster 2 workers", "dask", {}, 2),
+                 ("  the same, malloc trim unset", "dask, trim unset", {}, 2))
     summary = []
     for R in sizes:
         # 1. throughput, side by side in one run
@@ -132,7 +143,13 @@ def main():
         runs, walls, best = {}, {name: [] for name, *_ in executors}, {}
         for _ in range(rounds):
             for name, ex, kw, workers in executors:
-                mc, wall = timed(ex, R, **kw)
+                if ex.startswith("dask"):
+                    cluster, client, _ = start_cluster(ex == "dask")
+                    mc, wall = timed(client, R, **kw)
+                    client.close()
+                    cluster.close()
+                else:
+                    mc, wall = timed(ex, R, **kw)
                 walls[name].append(wall)
                 if name not in best or wall < best[name]:
                     runs[name], best[name] = mc, wall
@@ -157,10 +174,9 @@ def main():
         print(f"   R = {R:5d}: " + ", ".join(f"{name.strip()} {r:.2f}x" for RR, name, r in summary
                                            if RR == R and name != "serial"))
     if not n_noop:
-        for c in (client, cluster, client_nt, cluster_nt):
-            c.close()
         print(f"\nload average at the end: {load()}")
         return
+    cluster, client, _ = start_cluster()
 
     # 2. per-task overhead of empty tasks carrying the study's design
     model, ms = paper_model(), paper_multisine(seed=1)
@@ -193,8 +209,8 @@ def main():
                 W += 1
             C = min(32, math.ceil(RR / (4 * W)))
             print(f"   {label}, R = {RR}: W* = {W} workers (chunk {C}, {C * t_fit:.2f} s per task)")
-    for c in (client, cluster, client_nt, cluster_nt):
-        c.close()
+    client.close()
+    cluster.close()
     print(f"\nload average at the end: {load()}")
 
 
