@@ -1,13 +1,17 @@
 """Monte Carlo throughput of lptv.montecarlo on each executor, and the executors' per-task overhead.
 
     python bench/python/bench_batch.py [R] [n_noop] [rounds]   (default 2000, 2000, 2)
+    python bench/python/bench_batch.py --runs 64 256 --noop 0 --rounds 5
 
 1. The paper example (lptv.examples: model, multisine seed 1, P = 8, 50/30 dB coloured and
    correlated noise, lines 1..243), WGTLS, R realisations, as a user runs it:
-   ``lptv.montecarlo(..., executor=E)`` with E = "serial", "processes" (2 workers, the pool
-   started and stopped inside the call, as the default does) and a Dask LocalCluster of 2 worker
+   ``lptv.montecarlo(..., executor=E)`` with E = "serial", "processes" (2 workers) twice: with
+   the pool started and stopped inside the call (``lptv.batch.shutdown_pool()`` before and after
+   it, inside the time: what every call did before the pool was kept) and with the pool kept
+   from the previous call (what a second call does now), and a Dask LocalCluster of 2 worker
    processes with 1 thread each (started once before, as a cluster is; the client connected
-   once; one warm-up study of 4 runs so that the workers have imported lptv). Default chunking.
+   once; one warm-up study of 4 runs). Default chunking: from the cost of a realisation
+   measured on the previous call (``lptv.batch.chunk_sizes``).
    A second LocalCluster has Dask's MALLOC_TRIM_THRESHOLD_=65536 (set by its nannies in the
    workers' environment, so that glibc returns freed memory to the OS) unset: with it every
    array of 128 KB or more (the 8 x 2048 noisy periods, their spectra) is mapped and unmapped
@@ -31,9 +35,15 @@ import time
 import numpy as np
 
 import lptv
-from lptv.batch import default_chunk_size, run_tasks
+import lptv.batch.executors
+from lptv.batch import chunk_sizes, run_tasks, shutdown_pool
+from lptv.batch.study import realisation
+from lptv.batch.warm import kept_pool
 from lptv.examples import (PAPER_ID_LINES, PAPER_NOISE, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB, paper_model,
                            paper_multisine)
+
+
+COST_KEY = (realisation.__module__, realisation.__qualname__)
 
 
 def noop(item, shared):
@@ -51,61 +61,125 @@ def study(executor, R, **kw):
                            executor=executor, progress=False, **PAPER_NOISE, **kw)
 
 
+def parse(argv):
+    import argparse
+
+    ap = argparse.ArgumentParser(description="Monte Carlo throughput of lptv.montecarlo on each executor")
+    ap.add_argument("legacy", nargs="*", type=int, help="R n_noop rounds (the old positional form)")
+    ap.add_argument("--runs", nargs="+", type=int, help="study sizes R, each timed on every executor (default 2000)")
+    ap.add_argument("--noop", type=int, help="empty tasks of part 2 (default 2000; 0 skips parts 2 and 3)")
+    ap.add_argument("--rounds", type=int, help="rounds the executors take turns for (default 2)")
+    a = ap.parse_args(argv)
+    legacy = a.legacy + [None] * (3 - len(a.legacy))
+    runs = a.runs or [legacy[0] or 2000]
+    n_noop = a.noop if a.noop is not None else (legacy[1] if legacy[1] is not None else 2000)
+    rounds = a.rounds or legacy[2] or 2
+    return runs, n_noop, rounds
+
+
+def timed(executor, R, per_call=False, **kw):
+    """One study; with per_call the kept pool is shut down before and after it (both counted), so
+    that the call starts its own pool and ends it, as every call did before the pool was kept;
+    otherwise on processes a 4-run study before it (not counted) leaves the pool it finds."""
+    if executor == "processes" and not per_call:
+        study(executor, 4, **kw)   # the previous call (untimed): the pool is the one it left
+    t0 = time.perf_counter()
+    if per_call:
+        shutdown_pool()
+    mc = study(executor, R, **kw)
+    if per_call:
+        shutdown_pool()
+    return mc, mc.elapsed + (time.perf_counter() - t0 - mc.elapsed if per_call else 0.0)
+
+
 def main():
-    R = int(sys.argv[1]) if len(sys.argv) > 1 else 2000
-    n_noop = int(sys.argv[2]) if len(sys.argv) > 2 else 2000
-    rounds = int(sys.argv[3]) if len(sys.argv) > 3 else 2
+    sizes, n_noop, rounds = parse(sys.argv[1:])
     from distributed import Client, LocalCluster
 
     print(f"machine: {os.cpu_count()} cores, load average {load()} at the start")
     import dask
 
-    # First: a nanny also writes its pre-spawn environment into this process's os.environ, which
-    # the workers of a later cluster would inherit.
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-        cluster_nt = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  host="127.0.0.1")
-    client_nt = Client(cluster_nt)
-    study(client_nt, 4)
-    t0 = time.perf_counter()
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                           host="127.0.0.1")
-    client = Client(cluster)
-    t_cluster = time.perf_counter() - t0
-    study(client, 4)
-    print(f"Dask LocalCluster (2 workers x 1 thread) started in {t_cluster:.2f} s, warmed by a 4-run study")
-    trim = {c: next(iter(cl.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values()))
-            for c, cl in (("default", client), ("unset", client_nt))}
-    print(f"MALLOC_TRIM_THRESHOLD_ in the workers: {trim}")
+    def start_cluster(trim=True):
+        """A LocalCluster of 2 workers x 1 thread (Dask's default worker environment, or with
+        MALLOC_TRIM_THRESHOLD_ unset) and its client, warmed by a 4-run study. A nanny writes its
+        pre-spawn environment into this process's os.environ, where the process pool's workers
+        would find it: it is put back."""
+        env = dict(os.environ)
+        cfg = {} if trim else {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+        t0 = time.perf_counter()
+        with dask.config.set(cfg):
+            cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   host="127.0.0.1")
+        os.environ.clear()
+        os.environ.update(env)
+        client = Client(cluster)
+        started = time.perf_counter() - t0
+        study(client, 4)
+        return cluster, client, started
 
-    # 1. throughput, side by side in one run
-    print(f"\n1. paper example, WGTLS, R = {R}, P = 8: lptv.montecarlo as a user calls it "
-          f"(best of {rounds} rounds; every round's wall time in seconds shown)")
-    executors = (("serial", "serial", {}, 1), ("2 processes (pool per call)", "processes", {"workers": 2}, 2),
-                 ("Dask LocalCluster 2 workers", client, {}, 2),
-                 ("  the same, malloc trim unset", client_nt, {}, 2))
-    runs, walls = {}, {name: [] for name, *_ in executors}
-    for _ in range(rounds):
+    trim = {}
+    for label, flag in (("default", True), ("unset", False)):
+        cluster, client, t_cluster = start_cluster(flag)
+        trim[label] = next(iter(client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values()))
+        client.close()
+        cluster.close()
+    study("processes", 4, workers=2)
+    study("serial", 4)
+    print(f"Dask LocalCluster (2 workers x 1 thread) started in {t_cluster:.2f} s, warmed by a 4-run study "
+          "(lptv registers its warm-up plugin on the client); each Dask row starts its cluster before its "
+          "turn and closes it after,\nso that no idle cluster shares the cores with the other rows")
+    print(f"MALLOC_TRIM_THRESHOLD_ in the workers: {trim} (lptv raises glibc's thresholds around its "
+          "chunks where it is set)")
+    print("pool per call: lptv.batch.shutdown_pool() before and after the call, both inside the time "
+          "(the call forks, warms and ends its own pool);\npool kept: the pool of the previous call "
+          "(warm workers); chunks planned from the cost measured on the previous call")
+
+    executors = (("serial", "serial", {}, 1), ("2 processes (pool per call)", "processes", {"workers": 2, "per_call": True}, 2),
+                 ("2 processes (pool kept)", "processes", {"workers": 2}, 2),
+                 ("Dask LocalCluster 2 workers", "dask", {}, 2),
+                 ("  the same, malloc trim unset", "dask, trim unset", {}, 2))
+    summary = []
+    for R in sizes:
+        # 1. throughput, side by side in one run
+        print(f"\n1. paper example, WGTLS, R = {R}, P = 8: lptv.montecarlo as a user calls it "
+              f"(best of {rounds} rounds; every round's wall time in seconds shown)")
+        runs, walls, best = {}, {name: [] for name, *_ in executors}, {}
+        for _ in range(rounds):
+            for name, ex, kw, workers in executors:
+                if ex.startswith("dask"):
+                    cluster, client, _ = start_cluster(ex == "dask")
+                    mc, wall = timed(client, R, **kw)
+                    client.close()
+                    cluster.close()
+                else:
+                    mc, wall = timed(ex, R, **kw)
+                walls[name].append(wall)
+                if name not in best or wall < best[name]:
+                    runs[name], best[name] = mc, wall
+                print(f"   round {len(walls[name])}: {name} {wall:.3f} s (load {load()})", flush=True)
+        print(f"{'executor':34s} {'wall s':>8s} {'fits/min':>9s} {'vs serial':>9s}  {'chunks (last call)':18s} rounds")
         for name, ex, kw, workers in executors:
-            mc = study(ex, R, **kw)
-            walls[name].append(mc.elapsed)
-            if name not in runs or mc.elapsed < runs[name].elapsed:
-                runs[name] = mc
-            print(f"   round {len(walls[name])}: {name} {mc.elapsed:.2f} s (load {load()})", flush=True)
-    print(f"{'executor':34s} {'wall s':>8s} {'fits/min':>9s} {'vs serial':>9s} {'chunk':>5s}  rounds")
-    for name, ex, kw, workers in executors:
-        mc = runs[name]
-        chunk = default_chunk_size(R, workers) if ex != "serial" else 1
-        ratio = mc.fits_per_minute / runs["serial"].fits_per_minute
-        print(f"{name:34s} {mc.elapsed:8.2f} {mc.fits_per_minute:9.0f} {ratio:8.2f}x {chunk:5d}  "
-              + " ".join(f"{w:.1f}" for w in walls[name]), flush=True)
-    ref = runs["serial"].estimates["wgtls"]
-    for name, mc in runs.items():
-        assert np.array_equal(mc.estimates["wgtls"], ref, equal_nan=True), f"{name} differs from serial"
-    fails = sum(not f["ok"] for f in runs["serial"].fits)
-    print(f"estimates bit-identical on the three executors; {fails} failed fits; "
-          f"{runs['serial'].report().splitlines()[1].strip()}")
-    t_fit = runs["serial"].elapsed / R
+            plan = ("1 item at a time" if ex == "serial" else
+                    " ".join(map(str, chunk_sizes(R, workers, lptv.batch.executors._cost.get(COST_KEY)))))
+            ratio = best["serial"] / best[name]
+            print(f"{name:34s} {best[name]:8.3f} {60 * R / best[name]:9.0f} {ratio:8.2f}x  {plan[:18]:18s} "
+                  + " ".join(f"{w:.2f}" for w in walls[name]), flush=True)
+            summary.append((R, name, ratio))
+        ref = runs["serial"].estimates["wgtls"]
+        for name, mc in runs.items():
+            assert np.array_equal(mc.estimates["wgtls"], ref, equal_nan=True), f"{name} differs from serial"
+        fails = sum(not f["ok"] for f in runs["serial"].fits)
+        print(f"estimates bit-identical on every executor; {fails} failed fits; "
+              f"{runs['serial'].report().splitlines()[1].strip()}")
+        t_fit = best["serial"] / R
+    print("\nspeed-up over serial (best rounds):")
+    for R in sizes:
+        print(f"   R = {R:5d}: " + ", ".join(f"{name.strip()} {r:.2f}x" for RR, name, r in summary
+                                           if RR == R and name != "serial"))
+    if not n_noop:
+        print(f"\nload average at the end: {load()}")
+        return
+    cluster, client, _ = start_cluster()
 
     # 2. per-task overhead of empty tasks carrying the study's design
     model, ms = paper_model(), paper_multisine(seed=1)
@@ -116,7 +190,7 @@ def main():
     print(f"{'executor':34s} {'us/task':>8s} {'tasks/s':>8s} {'us/fit at chunk 32':>19s} {'% of a fit':>10s}")
     over = {}
     for name, ex, kw in (("serial", "serial", {}), ("2 processes (pool per call)", "processes", {"workers": 2}),
-                         ("Dask LocalCluster 2 workers", client, {})):
+                         ("2 processes (pool kept)", kept_pool(2), {}), ("Dask LocalCluster 2 workers", client, {})):
         t0 = time.perf_counter()
         out = run_tasks(noop, range(n_noop), design, executor=ex, chunk_size=1, progress=False, **kw)
         dt = (time.perf_counter() - t0) / n_noop
@@ -129,7 +203,7 @@ def main():
     S_meas = 1 / over["Dask LocalCluster 2 workers"]
     print(f"\n3. on paper: t_fit = {1e3 * t_fit:.1f} ms (serial); a task of C fits lasts C t_fit; W workers "
           "ask the scheduler for W / (C t_fit) tasks per second;\n   it saturates when that reaches its "
-          "rate S: W* = S C t_fit, with C = min(32, ceil(R / (4 W))) (the default chunking).")
+          "rate S: W* = S C t_fit, with C = min(32, ceil(R / (4 W))) (the chunking before a cost is measured).")
     for label, S in (("S measured here (client, scheduler, 2 workers on 2 shared cores)", S_meas),
                      ("S = 1000 tasks/s (distributed docs: about 1 ms per task)", 1000.0)):
         for RR in (R, 100000):
@@ -138,8 +212,8 @@ def main():
                 W += 1
             C = min(32, math.ceil(RR / (4 * W)))
             print(f"   {label}, R = {RR}: W* = {W} workers (chunk {C}, {C * t_fit:.2f} s per task)")
-    for c in (client, cluster, client_nt, cluster_nt):
-        c.close()
+    client.close()
+    cluster.close()
     print(f"\nload average at the end: {load()}")
 
 

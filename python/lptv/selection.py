@@ -1,7 +1,6 @@
 """Choosing the structure: orders and harmonic count from the data (METHOD.md section 13)."""
 from __future__ import annotations
 
-import concurrent.futures as cf
 import math
 import time
 import warnings
@@ -11,7 +10,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ._validate import as_int, as_positive_float, as_str
-from .batch.executors import available_cores, describe_executor, one_blas_thread, require, run_tasks
+from .batch.executors import describe_executor, one_blas_thread, require, run_tasks
 from .data import FrequencyData, frequency_data_of
 from .identify import IdentificationResult, _rows, identify
 from .nonparametric import HtfEstimate, htf_estimate
@@ -265,17 +264,8 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
                   ts=data.ts, periods=P, lines=rows, tol=tol, max_iter=max_iter, c=c)
     grid = [(a, b, kk, "wgtls") for a in na_list for b in nb_list for kk in k_list]
     label = describe_executor(executor, workers)
-    # one pool of processes for both stages (run_tasks leaves an executor it is given open)
-    pool = None
-    if workers is not None:      # run_tasks's own check of workers (and of the executor it needs)
-        run_tasks(fit_structure, [], None, executor=executor, workers=workers)
-    if executor == "processes":
-        pool = cf.ProcessPoolExecutor(max_workers=workers or available_cores())
-    try:
-        scored, ranked = _rank(grid, k_list, shared, criterion, refine, pool or executor, progress)
-    finally:
-        if pool is not None:
-            pool.shutdown(wait=True)
+    # executor="processes": both stages on the process pool kept between calls (lptv.batch.warm)
+    scored, ranked = _rank(grid, k_list, shared, criterion, refine, executor, workers, progress)
     top = ranked[0]
     choice = (top["na"], top["nb"], top["k"])
     choice_ok = bool(top["residue_ok"])
@@ -297,9 +287,9 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
                            elapsed=time.perf_counter() - t_start)
 
 
-def _rank(grid, k_list, shared, criterion, refine, executor, progress):
+def _rank(grid, k_list, shared, criterion, refine, executor, workers, progress):
     """WGTLS on the grid, SML on the shortlist; (scored rows, ranked rows)."""
-    out = run_tasks(fit_structure, grid, shared, executor=executor, progress=progress,
+    out = run_tasks(fit_structure, grid, shared, executor=executor, workers=workers, progress=progress,
                     desc="select: WGTLS", unit="fit")
     scored = [r if isinstance(r, dict) else _failed(item, r) for item, r in zip(grid, out)]
     if all(r["error"] for r in scored):
@@ -313,7 +303,7 @@ def _rank(grid, k_list, shared, criterion, refine, executor, progress):
         ordered = [r for r in sorted(scored, key=_key(criterion)) if not r["error"]]
         best = [r for kk in k_list for r in [r for r in ordered if r["k"] == kk][:refine]]
         items = [(r["na"], r["nb"], r["k"], "sml") for r in best]
-        out = run_tasks(fit_structure, items, shared, executor=executor, progress=progress,
+        out = run_tasks(fit_structure, items, shared, executor=executor, workers=workers, progress=progress,
                         desc="select: SML", unit="fit")
         for item, r, w in zip(items, out, best):
             new = r if isinstance(r, dict) else _failed(item, r)
