@@ -40,14 +40,6 @@ from lptv import NumericalError, distortion, frozen_poles, frozen_zeros, identif
 from lptv.apps.report import Report, write_json
 
 
-# bench/RESULTS.md, "The parametric BLA": 95 % intervals with the nonlinear variance cover
-# 93.7 % at P = 16 (pooled) but 99.2 % at P = 4.
-SMALL_P_NOTE = ("with P = {P} periods per realisation the noise and distortion variances are "
-                "conservative (95 % intervals covered 99.2 % at P = 4 in the Monte Carlo of "
-                "bench/RESULTS.md), so normalised residues 'too small' are to be expected; 8 or more "
-                "periods per realisation calibrate them")
-
-
 def _fail(src, problem) -> int:
     print(f"lptv identify: error: {src}: {' '.join(str(problem).split())}", file=sys.stderr)
     return 2
@@ -86,8 +78,6 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
           "level added to the output noise" if dist.detected else
           "model: the realisations fitted together (no nonlinear level to add)")
     print(res.summary())
-    if dist.detected and P < 8:
-        print(f"note: {SMALL_P_NOTE.format(P=P)}")
     for msg in extra:
         print(f"warning: {msg}")
     summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra)
@@ -160,8 +150,7 @@ def _report(src, meas, dist, res, summary) -> Report:
         f"{res.method.upper()} from the {M} realisations fitted together ({res.lines.size} lines in all)"
         + (", each output variance raised by the nonlinear level: the best linear time-periodic "
            "approximation, whose covariance includes the nonlinear distortion." if dist.detected else "."))
-    rep.paragraph("Verdict: " + res.verdict + "."
-                  + (" Note: " + SMALL_P_NOTE.format(P=P) + "." if dist.detected and P < 8 else ""))
+    rep.paragraph("Verdict: " + res.verdict + ".")
     rep.preformatted(res.summary())
     rep.figure(plots.bode(res), "bode.png",
                "Each realisation's measured FRF Y/U on its excited lines (+-2 std from its periods) and the "
