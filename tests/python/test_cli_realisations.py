@@ -90,3 +90,14 @@ def test_other_commands_refuse_realisations_with_one_line(tmp_path, capsys):
     rc = cli.main(["identify", str(src), str(src), *ARGS, "--joint", "--out", str(tmp_path / "j")])
     err = capsys.readouterr().err
     assert rc == 2 and "lptv identify FILE given alone" in err and len(err.strip().splitlines()) == 1
+
+
+def test_identify_file_of_realisations_errors_name_the_realisation(tmp_path, capsys):
+    src = tmp_path / "rig.npz"
+    _record(src, cubic=0.0, M=3, P=4, N=64)
+    rc = cli.main(["identify", str(src), *ARGS, "--lines", "1-500", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "realisation 0: lines:" in err and len(err.strip().splitlines()) == 1
+    rc = cli.main(["identify", str(src), *ARGS, "--covariance", "bootstrap", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--covariance bootstrap takes one record" in err

@@ -30,6 +30,7 @@ Example::
 """
 from __future__ import annotations
 
+import re
 import sys
 import warnings
 from pathlib import Path
@@ -47,6 +48,9 @@ def _fail(src, problem) -> int:
 
 def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     M, P, N = meas.u.shape
+    if getattr(args, "covariance", "analytic") != "analytic":
+        return _fail(src, "--covariance bootstrap takes one record of periods, not M x P x N realisations "
+                          "(their covariance includes the nonlinear distortion analytically)")
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -66,7 +70,9 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
             res = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
                            known=known, tol=args.tol, max_iter=args.max_iter)
     except (ValueError, NumericalError) as e:
-        return _fail(src, e)
+        # the realisations are the fit's experiments: name them as such
+        return _fail(src, re.sub(r"experiments?\[(\d+)\]|experiment (\d+)",
+                                 lambda g: f"realisation {g.group(1) or g.group(2)}", str(e)))
     said = set(res.warnings) | {res.unstable, res.stability_undecided}   # res.summary() prints these
     extra = list(dict.fromkeys(str(w.message) for w in caught if str(w.message) not in said))
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
