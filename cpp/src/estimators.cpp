@@ -47,21 +47,6 @@ std::string method_name(Method m) {
 
 namespace {
 
-// Nonzeros of Text: theta_p contributes Text(p, c) to xi column c.
-struct TextEntry {
-  int p, c;
-  cd v;
-};
-
-std::vector<TextEntry> text_entries(const Parametrisation& p) {
-  std::vector<TextEntry> out;
-  const Eigen::MatrixXcd& T = p.Text();
-  for (int c = 0; c < T.cols(); ++c)
-    for (int q = 0; q < T.rows(); ++q)
-      if (T(q, c) != cd(0.0, 0.0)) out.push_back({q, c, T(q, c)});
-  return out;
-}
-
 // QR of rows [begin, end) into an n x n upper-triangular R, block by block: each block B of
 // real rows is folded into R by LAPACK's dtpqrt (QR of [R; B] exploiting R's triangle,
 // blocked, on the BLAS), so the Jacobian is never held whole.
@@ -69,23 +54,21 @@ Eigen::MatrixXd r_factor_range(const FrequencyData& d, const Parametrisation& p,
                                const std::vector<int>& rows, const Eigen::VectorXd& weights,
                                size_t begin, size_t end) {
   const int n = p.n_xi();
-  const auto entries = text_entries(p);
+  const auto entries = detail::text_entries(p);
   constexpr int kBlock = 1024;  // complex rows per block: 2 * 1024 real rows
   const int nb = std::min(n, 32);
   Eigen::MatrixXd B(2 * kBlock, n), T(nb, n), work(nb, n);
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
   detail::RowPowers pw(p.structure());
   const detail::Lines X{d};
-  std::vector<cd> jrow(p.n_theta());
+  std::vector<cd> jrow;
   Eigen::VectorXcd xrow(n);
   for (size_t b0 = begin; b0 < end; b0 += kBlock) {
     const int m = static_cast<int>(std::min<size_t>(kBlock, end - b0));
     for (int r = 0; r < m; ++r) {
       const int l = rows[b0 + r];
       pw.compute(l);
-      detail::jacobian_row(p, X, pw, l, jrow.data());
-      xrow.setZero();
-      for (const auto& e : entries) xrow[e.c] += jrow[e.p] * e.v;
+      detail::jacobian_text_row(p, X, pw, l, entries, jrow, xrow.data());
       const double sw = weights.size() ? std::sqrt(weights[b0 + r]) : 1.0;
       B.row(2 * r) = sw * xrow.real().transpose();
       B.row(2 * r + 1) = sw * xrow.imag().transpose();
@@ -323,64 +306,39 @@ class WeightedRows {
 
   WeightedRows(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows)
       : d_(d), p_(p), rows_(rows) {
-    const int K = p.structure().kmax();
-    std::vector<std::vector<int>> by_k(2 * K + 1);
-    for (int q = 0; q < p.n_theta(); ++q) by_k[K + p.params()[q].k].push_back(q);
+    const auto by_k = detail::params_by_harmonic(p);
     size_t ne = 0;
     for (const auto& g : by_k) ne += g.size() * g.size();
     const size_t m = rows.size(), n = static_cast<size_t>(p.n_xi());
     const size_t bytes = m * (2 * n * sizeof(double) + ne * sizeof(cd));
     if (m == 0 || m >= kCacheRows || bytes > kCacheBytes) return;
     cached_ = true;
-    for (int k = -K; k <= K; ++k)
-      for (int a : by_k[K + k])
-        for (int b : by_k[K + k]) pairs_.push_back({a, b});
+    for (const auto& g : by_k)
+      for (int a : g)
+        for (int b : g) pairs_.push_back({a, b});
     // CJ(i, j) += Re(conj(T(a, i)) T(b, j) C(a, b)) for every listed entry (a, b).
-    const Eigen::MatrixXcd& T = p.Text();
+    const auto text = detail::text_entries(p);
     std::vector<std::vector<std::pair<int, cd>>> trow(static_cast<size_t>(p.n_theta()));
-    for (int c = 0; c < T.cols(); ++c)
-      for (int q = 0; q < T.rows(); ++q)
-        if (T(q, c) != cd(0.0, 0.0)) trow[static_cast<size_t>(q)].push_back({c, T(q, c)});
+    for (const auto& t : text) trow[static_cast<size_t>(t.p)].push_back({t.c, t.v});
     for (size_t e = 0; e < pairs_.size(); ++e)
       for (const auto& [i, ti] : trow[static_cast<size_t>(pairs_[e].first)])
         for (const auto& [j, tj] : trow[static_cast<size_t>(pairs_[e].second)])
           to_cj_.push_back({static_cast<int>(e), i, j, std::conj(ti) * tj});
-    const auto entries = text_entries(p);
     const detail::Lines X{d};
     detail::RowPowers pw(p.structure());
-    std::vector<cd> jrow(static_cast<size_t>(p.n_theta()));
+    std::vector<cd> jrow, f;
     Eigen::VectorXcd xrow(static_cast<Eigen::Index>(n));
     J_.resize(static_cast<Eigen::Index>(2 * m), static_cast<Eigen::Index>(n));
     C_.resize(static_cast<Eigen::Index>(ne), static_cast<Eigen::Index>(m));
-    std::vector<cd> f;
     for (size_t r = 0; r < m; ++r) {
       const int l = rows[r];
       pw.compute(l);
-      detail::jacobian_row(p, X, pw, l, jrow.data());
-      xrow.setZero();
-      for (const auto& e : entries) xrow[e.c] += jrow[static_cast<size_t>(e.p)] * e.v;
+      detail::jacobian_text_row(p, X, pw, l, text, jrow, xrow.data());
       J_.row(static_cast<Eigen::Index>(2 * r)) = xrow.real().transpose();
       J_.row(static_cast<Eigen::Index>(2 * r + 1)) = xrow.imag().transpose();
-      Eigen::Index e = 0;
-      for (int k = -K; k <= K; ++k) {
-        const auto& group = by_k[K + k];
-        const int i = l - k;
-        const double vy = X.varY(i), vu = X.varU(i);
-        const cd cyu = X.covYU(i);
-        f.resize(group.size());
-        for (size_t a = 0; a < group.size(); ++a) {
-          const Param& pr = p.params()[static_cast<size_t>(group[a])];
-          f[a] = (pr.is_a ? 1.0 : -1.0) * pw(k, pr.order);
-        }
-        for (size_t a = 0; a < group.size(); ++a) {
-          const bool ya = p.params()[static_cast<size_t>(group[a])].is_a;
-          for (size_t b = 0; b < group.size(); ++b) {
-            const bool yb = p.params()[static_cast<size_t>(group[b])].is_a;
-            const cd x = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
-            C_(e++, static_cast<Eigen::Index>(r)) = std::conj(f[a]) * f[b] * x;
-          }
-        }
-      }
+      Eigen::Index e = 0;  // the entries come in the order of pairs_
+      detail::noise_block_entries(p, X, pw, l, by_k, f,
+                                  [&](int, int, cd v) { C_(e++, static_cast<Eigen::Index>(r)) = v; });
     }
     B_.resize(J_.rows(), J_.cols());
     tau_.resize(J_.cols());

@@ -109,10 +109,7 @@ Eigen::MatrixXcd column_covariance(const FrequencyData& d, const Parametrisation
     throw std::invalid_argument("weights must have one entry per row");
   }
   const detail::Lines X{d};
-  const int K = p.structure().kmax();
-  // Parameters grouped by harmonic: only those share a noisy line within a row.
-  std::vector<std::vector<int>> by_k(2 * K + 1);
-  for (int q = 0; q < p.n_theta(); ++q) by_k[K + p.params()[q].k].push_back(q);
+  const auto by_k = detail::params_by_harmonic(p);
   Eigen::MatrixXcd parts[2];
   parts[0] = parts[1] = Eigen::MatrixXcd::Zero(p.n_theta(), p.n_theta());
   detail::parallel_rows(rows.size(), [&](size_t begin, size_t end, int part) {
@@ -123,27 +120,7 @@ Eigen::MatrixXcd column_covariance(const FrequencyData& d, const Parametrisation
       const double w = weights[r];
       if (w == 0.0) continue;
       pw.compute(rows[r]);
-      for (int k = -K; k <= K; ++k) {
-        const auto& group = by_k[K + k];
-        const int i = rows[r] - k;
-        const double vy = X.varY(i), vu = X.varU(i);
-        const cd cyu = X.covYU(i);
-        f.resize(group.size());
-        for (size_t a = 0; a < group.size(); ++a) {
-          const Param& pr = p.params()[group[a]];
-          f[a] = (pr.is_a ? 1.0 : -1.0) * pw(k, pr.order);  // dJ = f dX
-        }
-        for (size_t a = 0; a < group.size(); ++a) {
-          const bool ya = p.params()[group[a]].is_a;
-          const cd wfa = w * std::conj(f[a]);
-          for (size_t b = 0; b < group.size(); ++b) {
-            const bool yb = p.params()[group[b]].is_a;
-            // E{conj(dX_a) dX_b}
-            const cd e = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
-            C(group[a], group[b]) += wfa * f[b] * e;
-          }
-        }
-      }
+      detail::noise_block_entries(p, X, pw, rows[r], by_k, f, [&](int a, int b, cd v) { C(a, b) += w * v; });
     }
   });
   return parts[0] + parts[1];

@@ -232,28 +232,18 @@ double ExactLikelihood::cost(const Eigen::VectorXcd& theta) const {
 }
 
 Eigen::MatrixXd ExactLikelihood::real_jacobian(const FrequencyData& x) const {
-  // dr/dxi = [Re; Im] of J Text, rows interleaved; J[l, q] = +-s^n X_{l-k}. Text has one or
-  // two nonzeros per row: its nonzeros are listed once, not multiplied as a dense matrix.
+  // dr/dxi = [Re; Im] of J Text, rows interleaved; J[l, q] = +-s^n X_{l-k}, through Text's
+  // nonzeros (one or two per row), not a dense product.
   const detail::Lines X{x};
-  const Eigen::MatrixXcd& T = p_.Text();
-  struct Nz {
-    int q, c;
-    cd v;
-  };
-  std::vector<Nz> nz;
-  for (int c = 0; c < T.cols(); ++c)
-    for (int q = 0; q < T.rows(); ++q)
-      if (T(q, c) != cd(0.0, 0.0)) nz.push_back({q, c, T(q, c)});
+  const auto text = detail::text_entries(p_);
   const int R = static_cast<int>(sorted_.size());
   Eigen::MatrixXd out(2 * R, p_.n_xi());
   detail::RowPowers pw(p_.structure());
-  std::vector<cd> j(static_cast<size_t>(p_.n_theta()));
+  std::vector<cd> j;
   Eigen::RowVectorXcd jt(p_.n_xi());
   for (int r = 0; r < R; ++r) {
     pw.compute(sorted_[r]);
-    detail::jacobian_row(p_, X, pw, sorted_[r], j.data());
-    jt.setZero();
-    for (const Nz& e : nz) jt[e.c] += j[static_cast<size_t>(e.q)] * e.v;
+    detail::jacobian_text_row(p_, X, pw, sorted_[r], text, j, jt.data());
     out.row(2 * r) = jt.real();
     out.row(2 * r + 1) = jt.imag();
   }

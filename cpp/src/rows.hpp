@@ -35,6 +35,69 @@ inline void jacobian_row(const Parametrisation& p, const Lines& X, const RowPowe
   }
 }
 
+// Nonzeros of Text (theta = Text xi): theta_p contributes v to xi column c. One or two per row.
+struct TextEntry {
+  int p, c;
+  cd v;
+};
+
+inline std::vector<TextEntry> text_entries(const Parametrisation& p) {
+  std::vector<TextEntry> out;
+  const Eigen::MatrixXcd& T = p.Text();
+  for (int c = 0; c < T.cols(); ++c)
+    for (int q = 0; q < T.rows(); ++q)
+      if (T(q, c) != cd(0.0, 0.0)) out.push_back({q, c, T(q, c)});
+  return out;
+}
+
+// Row l of J Text (n_xi complex entries) into xrow, through Text's nonzeros; jrow is scratch
+// of n_theta entries (pw.compute(l) done).
+inline void jacobian_text_row(const Parametrisation& p, const Lines& X, const RowPowers& pw, int l,
+                              const std::vector<TextEntry>& text, std::vector<cd>& jrow, cd* xrow) {
+  jrow.resize(static_cast<size_t>(p.n_theta()));
+  jacobian_row(p, X, pw, l, jrow.data());
+  std::fill(xrow, xrow + p.n_xi(), cd(0.0, 0.0));
+  for (const TextEntry& e : text) xrow[e.c] += jrow[static_cast<size_t>(e.p)] * e.v;
+}
+
+// The entries of C_l = E{dJ_l^H dJ_l} that can be nonzero: for each harmonic k (group[K + k],
+// the parameters of harmonic k), f(a, b, value) for every pair (a, b) of the group, in that
+// order (pw.compute(l) done). dJ[l, q] = f_q dX_{l-k} with f = +s^n (a) or -s^n (b), and
+// E{conj(dX_a) dX_b} is var Y, var U or the cross-covariance of line l - k.
+template <class F>
+inline void noise_block_entries(const Parametrisation& p, const Lines& X, const RowPowers& pw, int l,
+                                const std::vector<std::vector<int>>& group, std::vector<cd>& f, F&& out) {
+  const int K = static_cast<int>(group.size() / 2);
+  for (int k = -K; k <= K; ++k) {
+    const auto& g = group[static_cast<size_t>(K + k)];
+    const int i = l - k;
+    const double vy = X.varY(i), vu = X.varU(i);
+    const cd cyu = X.covYU(i);
+    f.resize(g.size());
+    for (size_t a = 0; a < g.size(); ++a) {
+      const Param& pr = p.params()[static_cast<size_t>(g[a])];
+      f[a] = (pr.is_a ? 1.0 : -1.0) * pw(k, pr.order);
+    }
+    for (size_t a = 0; a < g.size(); ++a) {
+      const bool ya = p.params()[static_cast<size_t>(g[a])].is_a;
+      const cd fa = std::conj(f[a]);
+      for (size_t b = 0; b < g.size(); ++b) {
+        const bool yb = p.params()[static_cast<size_t>(g[b])].is_a;
+        const cd e = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
+        out(g[a], g[b], fa * f[b] * e);
+      }
+    }
+  }
+}
+
+// The parameters grouped by harmonic k (index K + k): only those share a noisy line in a row.
+inline std::vector<std::vector<int>> params_by_harmonic(const Parametrisation& p) {
+  const int K = p.structure().kmax();
+  std::vector<std::vector<int>> by_k(static_cast<size_t>(2 * K + 1));
+  for (int q = 0; q < p.n_theta(); ++q) by_k[static_cast<size_t>(K + p.params()[static_cast<size_t>(q)].k)].push_back(q);
+  return by_k;
+}
+
 // Runs f(begin, end, part) over [0, n) in up to two parts on two threads when n is large
 // enough to pay for a thread (the machines this targets have few cores; the kernels are
 // memory-light and scale).

@@ -42,7 +42,7 @@ import numpy as np
 from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_zeros, identify, lti_table,
                   parameter_table, plots, read_measurements, simulate)
 from lptv.apps.options import MAX_EXPANDED, bounded_range, in_option_terms, integer, output_folder
-from lptv.apps.report import Report, write_json
+from lptv.apps.report import Report, write_fit
 from lptv import METHODS
 from lptv.measurements import FileError
 
@@ -303,17 +303,8 @@ def run(args) -> int:
     for msg in extra:
         print(f"warning: {msg}")
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        res.model.save(out / "model.json")
-        write_json(out / "summary.json", summary)
-        _report(src, meas, res, Y_pred, summary).write(out)
-    except OSError as e:
-        return _fail(e.filename or out, e.strerror or e)
-    except ImportError:
-        return _fail(src, "writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'")
-    print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
-    return 0
+    failed = write_fit(out, res.model, summary, lambda: _report(src, meas, res, Y_pred, summary))
+    return _fail(failed[0] or src, failed[1]) if failed else 0
 
 
 def _prediction_gap_db(res, Y_pred):

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import FrequencyData, NumericalError, frozen_poles, frozen_zeros, identify, parameter_table, plots
+from lptv import FrequencyData, NumericalError, identify, parameter_table, plots
 from lptv.apps.fileid import fundamental, parse_counts, parse_known, parse_lines, positive, read_record
-from lptv.apps.report import Report, write_json
+from lptv.apps.report import Report, model_figures, write_fit
 from lptv.measurements import FileError
 
 
@@ -90,16 +90,9 @@ def run(args) -> int:
               f"{int(np.sum(res.experiment == e))} lines")
     print(res.summary())
     summary = _summary(args, records, ka, kb, res)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        model.save(out / "model.json")
-        write_json(out / "summary.json", summary)
-        _report(records, res, summary).write(out)
-    except OSError as e:
-        return _fail(f"{e.filename or out}: {e.strerror or e}")
-    except ImportError:
-        return _fail("writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'")
-    print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
+    failed = write_fit(out, model, summary, lambda: _report(records, res, summary))
+    if failed:
+        return _fail(failed[1] if failed[0] is None else f"{failed[0]}: {failed[1]}")
     return 0
 
 
@@ -158,14 +151,5 @@ def _report(records, res, summary) -> Report:
                    f"Normalised residue |e_l| / sqrt(var e_l) of record #{e} ({src}) against frequency, with "
                    "the 0 dB line; the excited lines marked (the verdict judges every row that reads a line "
                    "with signal).")
-    t = np.linspace(0.0, model.period, 400)
-    ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
-                                  discrete=model.discrete)
-    rep.figure(ax.figure, "frozen_poles_zeros.png",
-               "Frozen (instantaneous) poles (x) and zeros (o) of the joint model over one period "
-               + ("(z-plane)." if model.discrete else "(s-plane, rad/s)."))
-    names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
-    coef = np.hstack([model.a_at(t), model.b_at(t)]).real
-    ax = plots.coefficients(t, est=coef, names=names, ylabel="a_n(t), b_m(t)")
-    rep.figure(ax.figure, "coefficients.png", "The estimated coefficients a_n(t) and b_m(t) over one period.")
+    model_figures(rep, model, "the joint model")
     return rep

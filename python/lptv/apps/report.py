@@ -98,3 +98,40 @@ def write_json(path, obj):
 
     with atomic_open(os.fspath(path)) as f:
         json.dump(obj, f, indent=1, default=conv)
+
+
+PLOTS_EXTRA = "writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'"
+
+
+def write_fit(out, model, summary, report):
+    """Writes ``model.json``, ``summary.json`` and ``report.html`` (``report()`` builds the
+    :class:`Report`) into the folder ``out`` and says so; returns None, or ``(where, problem)``
+    for the command's one-line error (``where`` None when the problem is not a file's)."""
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        model.save(out / "model.json")
+        write_json(out / "summary.json", summary)
+        report().write(out)
+    except OSError as e:
+        return e.filename or out, e.strerror or e
+    except ImportError:
+        return None, PLOTS_EXTRA
+    print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
+    return None
+
+
+def model_figures(rep: Report, model, whose: str = "the model"):
+    """The frozen poles and zeros and the coefficients of an LPTV ``model`` over one period."""
+    from lptv import frozen_poles, frozen_zeros, plots
+
+    t = np.linspace(0.0, model.period, 400)
+    ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
+                                  discrete=model.discrete)
+    rep.figure(ax.figure, "frozen_poles_zeros.png",
+               f"Frozen (instantaneous) poles (x) and zeros (o) of {whose} over one period "
+               + ("(z-plane)." if model.discrete else "(s-plane, rad/s)."))
+    names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
+    coef = np.hstack([model.a_at(t), model.b_at(t)]).real
+    ax = plots.coefficients(t, est=coef, names=names, ylabel="a_n(t), b_m(t)")
+    rep.figure(ax.figure, "coefficients.png", "The estimated coefficients a_n(t) and b_m(t) over one period.")
