@@ -37,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import NumericalError, distortion, frozen_poles, frozen_zeros, identify, parameter_table, plots
-from lptv.apps.report import Report, write_json
+from lptv import NumericalError, distortion, identify, parameter_table, plots
+from lptv.apps.report import Report, model_figures, write_fit
 
 
 def _fail(src, problem) -> int:
@@ -80,24 +80,16 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
           f"w0 = {w0:.6g} rad/s" + (f", discrete-time model with ts = {ts:g} s" if ts else
                                     ", continuous-time model") + f") -> {out}/")
     print(dist.summary())
+    worth = ", ".join(str(e.periods) for e in exps)
     print("model: the best linear approximation, the realisations fitted together with the nonlinear "
-          "level added to the output noise" if dist.detected else
-          "model: the realisations fitted together (no nonlinear level to add)")
+          f"level added to the output noise (their variances worth {worth} periods: the P shown below)"
+          if dist.detected else "model: the realisations fitted together (no nonlinear level to add)")
     print(res.summary())
     for msg in extra:
         print(f"warning: {msg}")
     summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        res.model.save(out / "model.json")
-        write_json(out / "summary.json", summary)
-        _report(src, meas, dist, res, summary).write(out)
-    except OSError as e:
-        return _fail(e.filename or out, e.strerror or e)
-    except ImportError:
-        return _fail(src, "writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'")
-    print(f"wrote {out / 'model.json'}, {out / 'report.html'}, {out / 'summary.json'}")
-    return 0
+    failed = write_fit(out, res.model, summary, lambda: _report(src, meas, dist, res, summary))
+    return _fail(failed[0] or src, failed[1]) if failed else 0
 
 
 def _levels(dist):
@@ -155,20 +147,13 @@ def _report(src, meas, dist, res, summary) -> Report:
         f"{summary['kb']} on the b_m ({res.n_free_parameters} free parameters), identified by "
         f"{res.method.upper()} from the {M} realisations fitted together ({res.lines.size} lines in all)"
         + (", each output variance raised by the nonlinear level: the best linear time-periodic "
-           "approximation, whose covariance includes the nonlinear distortion." if dist.detected else "."))
+           "approximation, whose covariance includes the nonlinear distortion. Each realisation's raised "
+           "variance is worth more periods than it has (the P of the summary below: the degrees of "
+           "freedom of noise and level together, METHOD.md section 16)." if dist.detected else "."))
     rep.paragraph("Verdict: " + res.verdict + ".")
     rep.preformatted(res.summary())
     rep.figure(plots.bode(res), "bode.png",
                "Each realisation's measured FRF Y/U on its excited lines (+-2 std from its periods) and the "
                "model's time-averaged response with its 95 % band from the parameter covariance.")
-    t = np.linspace(0.0, model.period, 400)
-    ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
-                                  discrete=model.discrete)
-    rep.figure(ax.figure, "frozen_poles_zeros.png",
-               "Frozen (instantaneous) poles (x) and zeros (o) of the model over one period "
-               + ("(z-plane)." if model.discrete else "(s-plane, rad/s)."))
-    names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
-    coef = np.hstack([model.a_at(t), model.b_at(t)]).real
-    ax = plots.coefficients(t, est=coef, names=names, ylabel="a_n(t), b_m(t)")
-    rep.figure(ax.figure, "coefficients.png", "The estimated coefficients a_n(t) and b_m(t) over one period.")
+    model_figures(rep, model)
     return rep
