@@ -130,6 +130,10 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
       f.r[2 * r + 1] += v.imag();
     }
   }
+  if (diagonal()) {
+    factor_diagonal(f);
+    return f;
+  }
   // S in lower band storage: block (r, r') for r' = r..r+2K, from the entries of both rows
   // on the same physical line (row r' uses line m directly at k' = l' - m, and through its
   // conjugate at k' = l' + m).
@@ -185,6 +189,49 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
   return f;
 }
 
+// K = 0 (an LTI structure): each row uses its own line l >= 1 only (never a conjugate, never
+// DC), so S is block diagonal, the 2 x 2 block G H of each row, and so is its Cholesky
+// factor. The band route computes the same numbers: its entries between rows are exact
+// zeros, and every operation with them (x - 0 * y, x - 0) returns x; this route skips the
+// band's bookkeeping (the pairs of rows, the window sums). Lb keeps the band layout
+// (Lb(1, 2r + 1) = 0), so that everything reading the factor reads it as before.
+bool ExactLikelihood::diagonal() const { return K_ == 0 && detail::diagonal_likelihood_setting(); }
+
+void ExactLikelihood::factor_diagonal(Factor& f) const {
+  const int R = static_cast<int>(sorted_.size()), n = 2 * R;
+  f.Lb.resize(2, n);
+  for (int r = 0; r < R; ++r) {
+    const Factor::Entry& a = f.e[static_cast<size_t>(r)];
+    double blk[2][2];
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        double s = 0;
+        for (int c = 0; c < 4; ++c) s += a.G[i][c] * a.H[c][j];
+        blk[i][j] = 0.0 + s;  // the band route's sum over the one shared line
+      }
+    f.Lb(0, 2 * r) = blk[0][0];
+    f.Lb(1, 2 * r) = blk[0][1];
+    f.Lb(0, 2 * r + 1) = blk[1][1];
+    f.Lb(1, 2 * r + 1) = 0.0;
+  }
+  const double smax = f.Lb.row(0).maxCoeff();
+  for (int r = 0; r < R; ++r) {
+    for (int h = 0; h < 2; ++h) {
+      const int j = 2 * r + h;
+      double djj = f.Lb(0, j);
+      if (h == 1) djj -= f.Lb(1, j - 1) * f.Lb(1, j - 1);
+      if (!(djj > 1e-13 * smax) || !std::isfinite(djj)) {
+        throw NumericalError("the residue covariance is singular at row (line) " + std::to_string(sorted_[r]) +
+                             ": the lines it uses carry (almost) no noise, so the likelihood is undefined"
+                             " (use method='wgtls')");
+      }
+      const double ljj = std::sqrt(djj);
+      f.Lb(0, j) = ljj;
+      if (h == 0) f.Lb(1, j) = f.Lb(1, j) / ljj;
+    }
+  }
+}
+
 namespace {
 
 // X <- L^{-1} X, L lower banded (Lb(i - j, j)). One column: in place. Several: on the
@@ -192,6 +239,20 @@ namespace {
 // rows are strided).
 void forward_solve(const Eigen::MatrixXd& Lb, int kd, Eigen::Ref<Eigen::MatrixXd> X) {
   const Eigen::Index n = Lb.cols();
+  if (kd == 1 && detail::diagonal_likelihood_setting()) {
+    // K = 0: 2 x 2 blocks (Lb(1, 2r + 1) = 0), row pairs in place; the band loop's operations
+    // on them (its step across blocks subtracts 0 * x).
+    const Eigen::Index m = X.cols();
+    for (Eigen::Index j = 0; j + 1 < n; j += 2) {
+      const double l0 = Lb(0, j), l1 = Lb(1, j), l2 = Lb(0, j + 1);
+      for (Eigen::Index c = 0; c < m; ++c) {
+        const double x0 = X(j, c) / l0;
+        X(j, c) = x0;
+        X(j + 1, c) = (X(j + 1, c) - l1 * x0) / l2;
+      }
+    }
+    return;
+  }
   if (X.cols() == 1) {
     double* x = X.data();
     for (Eigen::Index j = 0; j < n; ++j) {
@@ -215,6 +276,13 @@ void forward_solve(const Eigen::MatrixXd& Lb, int kd, Eigen::Ref<Eigen::MatrixXd
 // x <- L^{-T} x.
 void backward_solve(const Eigen::MatrixXd& Lb, int kd, Eigen::VectorXd& x) {
   const Eigen::Index n = Lb.cols();
+  if (kd == 1 && detail::diagonal_likelihood_setting()) {  // K = 0: 2 x 2 blocks
+    for (Eigen::Index j = n - 2; j >= 0; j -= 2) {
+      x[j + 1] = x[j + 1] / Lb(0, j + 1);
+      x[j] = (x[j] - Lb(1, j) * x[j + 1]) / Lb(0, j);
+    }
+    return;
+  }
   for (Eigen::Index j = n - 1; j >= 0; --j) {
     double s = x[j];
     const Eigen::Index last = std::min<Eigen::Index>(n - 1, j + kd);
@@ -263,6 +331,21 @@ ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Factor& f, bool whit
   backward_solve(f.Lb, kd_, q);
   // x0 = x - Cov(n) M^T q, line by line over the entries that touch each line.
   ev.denoised = d_;
+  if (diagonal()) {  // K = 0: row r touches line sorted_[r] alone (rows are distinct)
+    const int R = static_cast<int>(sorted_.size());
+    for (int r = 0; r < R; ++r) {
+      const Factor::Entry& en = f.e[static_cast<size_t>(r)];
+      double z[4];
+      for (int a = 0; a < 4; ++a) z[a] = 0.0 + (en.H[a][0] * q[2 * r] + en.H[a][1] * q[2 * r + 1]);
+      ev.denoised.Y[en.m] -= cd(z[0], z[1]);
+      ev.denoised.U[en.m] -= cd(z[2], z[3]);
+    }
+    ev.jacobian = real_jacobian(ev.denoised);
+    if (!whiten) return ev;
+    forward_solve(f.Lb, kd_, ev.jacobian);
+    ev.gradient = 2.0 * ev.jacobian.transpose() * ev.whitened;
+    return ev;
+  }
   std::vector<std::array<double, 4>> z(d_.max_line() + 1, {0.0, 0.0, 0.0, 0.0});
   const int R = static_cast<int>(sorted_.size()), W = 2 * K_ + 1;
   std::vector<char> touched(d_.max_line() + 1, 0);

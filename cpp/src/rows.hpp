@@ -98,6 +98,19 @@ inline std::vector<std::vector<int>> params_by_harmonic(const Parametrisation& p
   return by_k;
 }
 
+// Whether the exact likelihood takes its diagonal route for K = 0 (an LTI structure: S is
+// block diagonal, one 2 x 2 block per row; likelihood.cpp). The same bits as the band route;
+// the tests turn it off to compare the two. Returns the previous setting.
+inline bool& diagonal_likelihood_setting() {
+  static bool on = true;
+  return on;
+}
+inline bool set_diagonal_likelihood(bool on) {
+  const bool before = diagonal_likelihood_setting();
+  diagonal_likelihood_setting() = on;
+  return before;
+}
+
 // Runs f(begin, end, part) over [0, n) in up to two parts on two threads when n is large
 // enough to pay for a thread (the machines this targets have few cores; the kernels are
 // memory-light and scale).

@@ -78,6 +78,9 @@ class ExactLikelihood {
                                       const Eigen::VectorXcd& theta0, double tol, int max_iter);
   void init(const std::vector<int>& rows);  // sorted rows and bandwidth, after the checks
   Factor factor(const Eigen::VectorXcd& theta) const;
+  // K = 0: S block diagonal, factored row by row (the same bits as the band route).
+  bool diagonal() const;
+  void factor_diagonal(Factor& f) const;
   // With whiten = false: cost, w and x0, and the Jacobian at x0 not whitened (no gradient).
   Evaluation evaluate(const Factor& f, bool whiten) const;
   Eigen::MatrixXd real_jacobian(const FrequencyData& x) const;  // dr/dxi, sorted-row order
