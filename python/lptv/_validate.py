@@ -214,7 +214,14 @@ def as_int_list(x, name, minimum=0, maximum=INT_MAX):
             return list(x)
     else:
         arr = x
-        if isinstance(x, (list, tuple)) and len(x) > 8 and not any(isinstance(v, (bool, np.bool_)) for v in x):
+        # The types of a list's entries at C speed (a generator over the entries cost 0.1 ms per
+        # call at 500 lines): plain ints are checked by their bounds; bools (which NumPy would
+        # take as integers) go the long way.
+        types = set(map(type, x)) if isinstance(x, (list, tuple)) and len(x) > 8 else None
+        if types is not None and types == {int}:
+            if min(x) >= minimum and max(x) <= maximum:
+                return list(x)
+        elif types is not None and bool not in types and np.bool_ not in types:
             try:
                 arr = np.asarray(x)   # a list of Python or NumPy integers: dtype int64
             except (TypeError, ValueError, OverflowError):
