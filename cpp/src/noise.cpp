@@ -47,7 +47,7 @@ FrequencyData frequency_data_from_periods(const Eigen::MatrixXd& u, const Eigen:
   if (!u.allFinite()) throw std::invalid_argument("u contains NaN or inf");
   if (!y.allFinite()) throw std::invalid_argument("y contains NaN or inf");
   const Eigen::Index N = u.cols(), nl = N / 2 + 1;
-  Eigen::MatrixXcd Up(nl, P), Yp(nl, P);
+  PeriodSpectra Up(P, nl), Yp(P, nl);
   // One FFT object for every period (its plan and twiddles made once), half spectra only.
   Eigen::FFT<double> fft;
   fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
@@ -57,21 +57,51 @@ FrequencyData frequency_data_from_periods(const Eigen::MatrixXd& u, const Eigen:
   for (int p = 0; p < P; ++p) {
     row = u.row(p).transpose();
     fft.fwd(X, row);
-    Up.col(p) = X.head(nl) * inv_n;
+    Up.row(p) = X.head(nl).transpose() * inv_n;
     row = y.row(p).transpose();
     fft.fwd(X, row);
-    Yp.col(p) = X.head(nl) * inv_n;
+    Yp.row(p) = X.head(nl).transpose() * inv_n;
   }
+  return frequency_data_from_period_spectra(Up, Yp);
+}
+
+FrequencyData frequency_data_from_period_spectra(const Eigen::Ref<const PeriodSpectra>& Up,
+                                                 const Eigen::Ref<const PeriodSpectra>& Yp) {
+  if (Up.rows() != Yp.rows() || Up.cols() != Yp.cols()) {
+    throw std::invalid_argument("Up and Yp must have the same shape (P, lines), got (" +
+                                std::to_string(Up.rows()) + ", " + std::to_string(Up.cols()) + ") and (" +
+                                std::to_string(Yp.rows()) + ", " + std::to_string(Yp.cols()) + ")");
+  }
+  const int P = static_cast<int>(Up.rows());
+  if (P < 2) {
+    throw std::invalid_argument("u, y: at least 2 periods are needed for a noise model, got " +
+                                std::to_string(P));
+  }
+  if (Up.cols() < 1) throw std::invalid_argument("Up, Yp: no lines");
+  if (!Up.allFinite()) throw std::invalid_argument("Up contains NaN or inf");
+  if (!Yp.allFinite()) throw std::invalid_argument("Yp contains NaN or inf");
+  const Eigen::Index nl = Up.cols();
   FrequencyData d;
   d.periods = P;
-  d.U = Up.rowwise().mean();
-  d.Y = Yp.rowwise().mean();
-  const Eigen::MatrixXcd dU = Up.colwise() - d.U;
-  const Eigen::MatrixXcd dY = Yp.colwise() - d.Y;
+  d.U = Up.colwise().mean().transpose();
+  d.Y = Yp.colwise().mean().transpose();
+  d.varU.resize(nl);
+  d.varY.resize(nl);
+  d.covYU.resize(nl);
   const double scale = 1.0 / (double(P) * double(P - 1));  // variance of the mean
-  d.varU = dU.cwiseAbs2().rowwise().sum() * scale;
-  d.varY = dY.cwiseAbs2().rowwise().sum() * scale;
-  d.covYU = (dY.array() * dU.conjugate().array()).rowwise().sum().matrix() * scale;
+  for (Eigen::Index l = 0; l < nl; ++l) {
+    double vu = 0, vy = 0;
+    std::complex<double> c = 0;
+    for (int p = 0; p < P; ++p) {
+      const std::complex<double> du = Up(p, l) - d.U[l], dy = Yp(p, l) - d.Y[l];
+      vu += std::norm(du);
+      vy += std::norm(dy);
+      c += dy * std::conj(du);
+    }
+    d.varU[l] = vu * scale;
+    d.varY[l] = vy * scale;
+    d.covYU[l] = c * scale;
+  }
   return d;
 }
 

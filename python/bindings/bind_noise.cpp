@@ -16,6 +16,12 @@ void bind_noise(py::module_& m) {
         py::gil_scoped_release release;  // FFTs only
         return lptv::frequency_data_from_periods(u, y);
       }, "u"_a, "y"_a)
+      .def_static("from_period_spectra", [](const Eigen::Ref<const lptv::PeriodSpectra>& Up,
+                                            const Eigen::Ref<const lptv::PeriodSpectra>& Yp) {
+        return lptv::frequency_data_from_period_spectra(Up, Yp);
+      }, "Up"_a, "Yp"_a,
+        "The statistics of from_periods from the periods' spectra: Up, Yp of shape (P, lines), row p "
+        "the spectrum of period p (fft / N) on lines 0..Lmax.")
       .def_readonly("U", &lptv::FrequencyData::U)
       .def_readonly("Y", &lptv::FrequencyData::Y)
       .def_readonly("varU", &lptv::FrequencyData::varU)

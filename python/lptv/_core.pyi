@@ -74,6 +74,11 @@ class FrequencyData:
     Mean spectra on lines 0..Lmax and the (co)variances of the means.
     """
     @staticmethod
+    def from_period_spectra(Up: typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]", "flags.c_contiguous"], Yp: typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]", "flags.c_contiguous"]) -> FrequencyData:
+        """
+        The statistics of from_periods from the periods' spectra: Up, Yp of shape (P, lines), row p the spectrum of period p (fft / N) on lines 0..Lmax.
+        """
+    @staticmethod
     def from_periods(u: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], y: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> FrequencyData:
         ...
     def __init__(self, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], varU: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], varY: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], covYU: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex = 0) -> None:

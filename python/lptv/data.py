@@ -112,8 +112,17 @@ class FrequencyData:
             if abs(n_expected - u.shape[1]) > 1e-6 * u.shape[1]:
                 raise ValueError(f"u, y: {u.shape[1]} samples per period, but w0 = {w0:g} and ts = {ts:g} "
                                  f"give 2 pi / (w0 ts) = {n_expected:.6g}")
+        if u.shape[1] < 2:
+            raise ValueError("u, y: a period needs at least 2 samples")
+        # NumPy's FFT (pocketfft, all periods in one call) and the statistics in the core: about
+        # three times as fast as the core's own from_periods (Eigen's FFT, one period at a time).
+        n = u.shape[1]
+        Up = np.fft.rfft(u, axis=1)
+        Up *= 1.0 / n
+        Yp = np.fft.rfft(y, axis=1)
+        Yp *= 1.0 / n
         obj = cls.__new__(cls)
-        obj._set(_core.FrequencyData.from_periods(u, y), w0, ts)
+        obj._set(_core.FrequencyData.from_period_spectra(Up, Yp), w0, ts)
         return obj
 
     U = property(lambda self: np.asarray(self._cpp.U), doc="Mean input spectrum, lines 0..Lmax.")
