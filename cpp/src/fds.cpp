@@ -373,7 +373,7 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   // the magnitude of the terms in each row. An entry that cancels to rounding level (a pole
   // on a grid line up to rounding) makes the solution huge exactly there; a large but
   // accurately computed entry (high frequencies, high orders) does not.
-  const Eigen::VectorXcd x = solve_A(check_rhs(m, grid_));
+  const Eigen::VectorXcd x = solve_factored(check_rhs(m, grid_));
   Eigen::Index where = 0;
   condition_ = x.cwiseAbs().maxCoeff(&where);
   condition_line_ = grid_.line_of(static_cast<int>(where));
@@ -415,9 +415,17 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
   return out;
 }
 
-Eigen::MatrixXcd Fds::solve_A(const Eigen::MatrixXcd& rhs) const {
+Eigen::MatrixXcd Fds::solve_factored(const Eigen::MatrixXcd& rhs) const {
   if (small_) return small_->solve(rhs);
   return band_ ? band_->solve(rhs) : lu_->solve(rhs);
+}
+
+Eigen::MatrixXcd Fds::solve_A(const Eigen::MatrixXcd& rhs) const {
+  if (rhs.rows() != grid_.N) {
+    throw std::invalid_argument("rhs must have " + std::to_string(grid_.N) + " rows (the grid), got " +
+                                std::to_string(rhs.rows()));
+  }
+  return solve_factored(rhs);
 }
 
 Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
@@ -425,7 +433,7 @@ Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
     throw std::invalid_argument("U must have " + std::to_string(grid_.N) +
                                 " rows (the grid), got " + std::to_string(U.rows()));
   }
-  return solve_A(apply_B(model_, grid_, U));
+  return solve_factored(apply_B(model_, grid_, U));
 }
 
 Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {
