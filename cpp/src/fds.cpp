@@ -68,17 +68,30 @@ cd line_power(const Model& m, const Grid& g, int line, int n) {
 
 namespace {
 
+// The harmonics k whose column of c (K + k) holds a nonzero coefficient. A zero column adds
+// exact zeros to the band sums, so leaving it out changes no bit; it matters for models whose
+// harmonics are sparse, such as a record's (lptv::fit_record: only the multiples of L, 2K + 1
+// of 2 K L + 1 columns).
+std::vector<int> nonzero_harmonics(const Eigen::MatrixXcd& c) {
+  const int K = static_cast<int>(c.cols() - 1) / 2;
+  std::vector<int> ks;
+  for (int k = -K; k <= K; ++k)
+    if (!c.col(K + k).isZero(0.0)) ks.push_back(k);
+  return ks;
+}
+
 // Entries sum_n c_{n,l-i} s_i^n for |l-i| <= K; on the circular grid the band wraps.
 SpMat build_band(const Model& m, const Grid& g, const Eigen::MatrixXcd& c) {
   const int order = static_cast<int>(c.rows()) - 1;
   const int K = static_cast<int>(c.cols() - 1) / 2;
+  const std::vector<int> ks = nonzero_harmonics(c);
   std::vector<Eigen::Triplet<cd, int>> trip;
-  trip.reserve(static_cast<size_t>(g.N) * (2 * K + 1));
+  trip.reserve(static_cast<size_t>(g.N) * ks.size());
   std::vector<cd> pw(order + 1);
   for (int col = 0; col < g.N; ++col) {
     const int i = g.line_of(col);
     detail::line_powers(detail::line_variable(m.w0(), m.ts(), i), order, pw.data());
-    for (int k = -K; k <= K; ++k) {
+    for (const int k : ks) {
       const int row = g.index_of(i + k);
       if (row < 0) continue;
       const cd v = detail::band_entry(c.col(K + k).data(), pw.data(), order);
@@ -142,12 +155,13 @@ constexpr double kGoldenAngle = detail::kCheckPhaseStep;
 Eigen::VectorXcd check_rhs(const Model& m, const Grid& grid) {
   const int K = m.ka(), na = m.na();
   const Eigen::MatrixXd absa = m.a().cwiseAbs();  // |a_{n,k}|, once
+  const std::vector<int> ks = nonzero_harmonics(m.a());
   Eigen::VectorXd mag = Eigen::VectorXd::Zero(grid.N);
   std::vector<double> wn(na + 1);
   for (int j = 0; j < grid.N; ++j) {
     const int i = grid.line_of(j);
     detail::line_powers(std::abs(detail::line_variable(m.w0(), m.ts(), i)), na, wn.data());
-    for (int k = -K; k <= K; ++k) {
+    for (const int k : ks) {
       const int row = grid.index_of(i + k);
       if (row >= 0) mag[row] += detail::band_entry(absa.col(K + k).data(), wn.data(), na);
     }
@@ -373,7 +387,7 @@ Fds::Fds(const Model& m, int L, Solver solver) : model_(m), grid_(make_grid(m, L
   // the magnitude of the terms in each row. An entry that cancels to rounding level (a pole
   // on a grid line up to rounding) makes the solution huge exactly there; a large but
   // accurately computed entry (high frequencies, high orders) does not.
-  const Eigen::VectorXcd x = solve_A(check_rhs(m, grid_));
+  const Eigen::VectorXcd x = solve_factored(check_rhs(m, grid_));
   Eigen::Index where = 0;
   condition_ = x.cwiseAbs().maxCoeff(&where);
   condition_line_ = grid_.line_of(static_cast<int>(where));
@@ -415,9 +429,17 @@ GridSolution solve_grid(const Model& m, int L, const Eigen::MatrixXcd& U_full, S
   return out;
 }
 
-Eigen::MatrixXcd Fds::solve_A(const Eigen::MatrixXcd& rhs) const {
+Eigen::MatrixXcd Fds::solve_factored(const Eigen::MatrixXcd& rhs) const {
   if (small_) return small_->solve(rhs);
   return band_ ? band_->solve(rhs) : lu_->solve(rhs);
+}
+
+Eigen::MatrixXcd Fds::solve_A(const Eigen::MatrixXcd& rhs) const {
+  if (rhs.rows() != grid_.N) {
+    throw std::invalid_argument("rhs must have " + std::to_string(grid_.N) + " rows (the grid), got " +
+                                std::to_string(rhs.rows()));
+  }
+  return solve_factored(rhs);
 }
 
 Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
@@ -425,7 +447,7 @@ Eigen::MatrixXcd Fds::solve_full(const Eigen::MatrixXcd& U) const {
     throw std::invalid_argument("U must have " + std::to_string(grid_.N) +
                                 " rows (the grid), got " + std::to_string(U.rows()));
   }
-  return solve_A(apply_B(model_, grid_, U));
+  return solve_factored(apply_B(model_, grid_, U));
 }
 
 Eigen::MatrixXcd Fds::htf_columns(const std::vector<int>& input_lines) const {

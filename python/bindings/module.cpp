@@ -24,5 +24,6 @@ PYBIND11_MODULE(_core, m) {
   bind_estimators(m);
   bind_htf_estimate(m);
   bind_distortion(m);
+  bind_record(m);
   bind_floquet(m);
 }

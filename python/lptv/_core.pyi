@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -434,6 +434,67 @@ class DistortionLines:
     @property
     def total(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
+class RecordFit:
+    """
+    One record with its transient (lptv::fit_record).
+    """
+    @property
+    def Y_fit(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def cost(self) -> float:
+        ...
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        of eta: the inverse Fisher information of the output error at the estimate
+        """
+    @property
+    def dof(self) -> int:
+        ...
+    @property
+    def eta(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        xi with xi[norm_index] = 1
+        """
+    @property
+    def evaluations(self) -> int:
+        """
+        factorisations of A, all fits
+        """
+    @property
+    def fits(self) -> int:
+        ...
+    @property
+    def iterations(self) -> int:
+        """
+        Levenberg-Marquardt iterations of the last fit
+        """
+    @property
+    def noise_dof(self) -> int:
+        ...
+    @property
+    def noise_var(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def start(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        [free eta, c] from the weighted equation error
+        """
+    @property
+    def theta(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def transient(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        c_1..c_n of T(z) = sum c_j z^j
+        """
+    @property
+    def transient_std(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 class Floquet:
     """
     Characteristic multipliers and Floquet exponents (lptv::floquet).
@@ -514,6 +575,35 @@ def excited_lines(data: FrequencyData, ratio: typing.SupportsFloat | typing.Supp
     ...
 def expected_fraction_above_0db(n_rows: typing.SupportsInt | typing.SupportsIndex, n_free: typing.SupportsInt | typing.SupportsIndex, periods: typing.SupportsInt | typing.SupportsIndex) -> tuple[float, tuple[float, float]]:
     ...
+def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True, noise_var: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] | None = None, noise_width: typing.SupportsInt | typing.SupportsIndex = 10, reweightings: typing.SupportsInt | typing.SupportsIndex = 2, max_iterations: typing.SupportsInt | typing.SupportsIndex = 100, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-12) -> RecordFit:
+    """
+    A discrete-time LPTV model and the transient term fitted to one record (METHOD.md section 17).
+    
+    Parameters
+    ----------
+    par : Parametrisation
+        The structure (discrete time).
+    U, Y : ndarray, shape (N,), complex
+        The record's DFT on all N = periods N0 lines: X_l = fft(x)[l] / N.
+    periods : int
+        L, whole parameter periods in the record.
+    lines : list of int
+        The lines fitted, ascending, within 1..(N-1)/2.
+    transient : bool
+        Fit T(z) = sum_{j=1}^{n} c_j z^j, n = max(na, nb).
+    noise_var : ndarray, optional
+        E|V_l|^2 per fitted line; None: from the fit's residual, averaged over 2 noise_width + 1
+        lines and debiased for the parameters, then the fit repeated ``reweightings`` times.
+    noise_width, reweightings : int
+    max_iterations : int
+        Levenberg-Marquardt iterations per fit.
+    tol : float
+        Relative tolerance of the cost's decrease, the step and the gradient's cosine.
+    
+    Returns
+    -------
+    RecordFit
+    """
 def floquet(model: Model, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-11, min_truncation: typing.SupportsInt | typing.SupportsIndex = 8, max_truncation: typing.SupportsInt | typing.SupportsIndex = 256) -> Floquet:
     """
     Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).
@@ -548,6 +638,14 @@ def multisine_spectrum(lines: collections.abc.Sequence[typing.SupportsInt | typi
     ...
 def real_column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+def record_prediction(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, eta_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], c: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+    """
+    Y_hat = A^-1 (B U - T(c)) on all N lines of the record's grid (eta_free: the free parameters).
+    """
+def record_regression(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]]:
+    """
+    The equation error on the lines, E = M x + e0 for x = [free eta, c]: (M, e0).
+    """
 def residue(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     ...
 def residue_variance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:

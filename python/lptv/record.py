@@ -3,24 +3,22 @@
 ``lptv.identify_record(u, y, ...)``: a single record of L whole parameter periods, started from an
 unknown state under an arbitrary input (no repeated periods). On the record's DFT grid (spacing
 w0 / L) the model's harmonic k shifts a spectrum by k L lines, and the transient is a polynomial
-T of degree max(na, nb) with real coefficients (section 17). The output noise level comes from
-the local polynomial method; the model and T are fitted by output-error maximum likelihood
-(the input is taken as exact: one record cannot tell input noise from input), with the
-frequency-domain simulator of the core solving A Y = B U - T for the prediction and its
-Jacobian.
+T of degree max(na, nb) with real coefficients (section 17). The model and T are fitted by
+output-error maximum likelihood (the input is taken as exact: one record cannot tell input noise
+from input) in the C++ core (``lptv::fit_record``: the equation-error start, Levenberg-Marquardt
+with the exact Jacobian on one factorisation of A per step, the residual's noise level, the
+covariance); this module checks the arguments, takes the DFTs and, for ``noise="lpm"``, runs the
+local polynomial method. The NumPy and SciPy route it replaced is :mod:`lptv.reference.record`.
 """
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from . import _core
 from ._validate import as_counts, as_int, as_real_1d
-from .fds import simulate
 from .model import Model
 
 
@@ -61,6 +59,7 @@ class RecordResult:
     """2 n_lines - number of real parameters."""
     converged: bool
     iterations: int
+    """Levenberg-Marquardt iterations of the last fit (the residual route fits three times)."""
 
     @property
     def cost_ratio(self) -> float:
@@ -74,39 +73,6 @@ def _record_periods(n_total, n0, name):
                          f"got {n_total} samples ({n_total / n0:.3f} periods): drop "
                          f"{n_total % n0} samples at the start")
     return n_total // n0
-
-
-class _Grid:
-    """The record's DFT grid and the band operators of a coefficient set on it."""
-
-    def __init__(self, N, L):
-        self.N, self.L = N, L
-        self.x = np.exp(2j * np.pi * np.arange(N) / N)          # z_m (discrete time)
-
-    def apply(self, coef, X):
-        """sum_p sum_k coef[p, K+k] x_{l-kL}^p X_{l-kL} on the full grid."""
-        K = (coef.shape[1] - 1) // 2
-        out = np.zeros(self.N, dtype=complex)
-        for p in range(coef.shape[0]):
-            xp = self.x**p * X
-            for k in range(-K, K + 1):
-                c = coef[p, K + k]
-                if c != 0:
-                    out += c * np.roll(xp, k * self.L)
-        return out
-
-    def transient_basis(self, n):
-        """n columns: z^1..z^n (section 17)."""
-        return np.stack([self.x**j for j in range(1, n + 1)], axis=1)
-
-
-def _full(X_one, N):
-    """Full DFT array from lines 0..N//2 of a real signal's spectrum."""
-    full = np.zeros(N, dtype=complex)
-    full[: N // 2 + 1] = X_one
-    idx = np.arange(1, (N + 1) // 2)
-    full[N - idx] = np.conj(X_one[idx])
-    return full
 
 
 def local_polynomial_noise(U, Y, L, lines, *, branches: int, degree: int = 2, half_width: Optional[int] = None,
@@ -229,7 +195,6 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         if lines.min() < 1 or lines.max() > N // 2 - 1:
             raise ValueError(f"lines must lie in 1..{N // 2 - 1} (the record's grid), got "
                              f"{lines.min()}..{lines.max()}")
-    grid = _Grid(N, L)
     U = np.fft.fft(u) / N
     Y = np.fft.fft(y) / N
     kmax = max(ka_l + kb_l)
@@ -262,119 +227,26 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
                              f"({lines.size}), got shape {np.shape(noise)}")
         noise_dof = 0
 
-    # coefficient arrays of theta, and the unit directions of eta
+    residual = isinstance(noise, str) and noise == "residual"
+    fit = _core.fit_record(par, U, Y, L, [int(v) for v in lines], transient=bool(transient),
+                           noise_var=None if residual else var, noise_width=noise_width,
+                           max_iterations=max_iterations)
+    if residual:
+        var, noise_dof = np.asarray(fit.noise_var), fit.noise_dof
+
+    # the estimated model: theta's harmonics laid out as Model holds them
     Ka, Kb = max(ka_l), max(kb_l)
-    params = par.params
-
-    def arrays(theta):
-        a = np.zeros((na + 1, 2 * Ka + 1), dtype=complex)
-        b = np.zeros((nb + 1, 2 * Kb + 1), dtype=complex)
-        for (is_a, order, k), v in zip(params, theta):
-            if is_a:
-                a[order, Ka + k] = v
-            else:
-                b[order, Kb + k] = v
-        return a, b
-
-    Text = np.asarray(par.Text)
-    free = list(par.free_indices)
-    norm = par.norm_index
-    dirs = [arrays(Text[:, i]) for i in free]
-    a_norm, b_norm = arrays(Text[:, norm])
-    V = grid.transient_basis(nT) if nT else np.zeros((N, 0))
-
-    def theta_of(eta):
-        xi = np.zeros(par.n_xi)
-        xi[free] = eta
-        xi[norm] = 1.0
-        return Text @ xi
-
-    # start: the equation error E = A Y - B U + T, linear in eta and c, by weighted least squares
-    E0 = grid.apply(a_norm, Y) - grid.apply(b_norm, U)
-    cols = [grid.apply(ad, Y) - grid.apply(bd, U) for ad, bd in dirs]
-    Mf = np.stack(cols, axis=1) if cols else np.zeros((N, 0))
-    Mf = np.concatenate([Mf, V], axis=1)
-    sc = 1.0 / np.sqrt(var)
-    Mr = np.concatenate([(Mf[lines] * sc[:, None]).real, (Mf[lines] * sc[:, None]).imag])
-    br = -np.concatenate([(E0[lines] * sc).real, (E0[lines] * sc).imag])
-    x0, *_ = np.linalg.lstsq(Mr, br, rcond=None)
-    w = 1.0 / np.sqrt(var / 2.0)          # Re and Im of V_l each have variance var / 2
-
-    def record_model(a):
-        a_rec = np.zeros((na + 1, 2 * Ka * L + 1), dtype=complex)
-        a_rec[:, Ka * L + L * np.arange(-Ka, Ka + 1)] = a
-        return Model(a_rec, [[1.0]], w0=float(w0) / L, ts=ts)
-
-    def one(X):
-        return X[: N // 2 + 1]
-
-    def solve(a, R):
-        """A^-1 R on the record's grid (R: full arrays, columns), by the core's FDS."""
-        R1 = one(R).copy()
-        R1[0] = R1[0].real
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            Yh = simulate(record_model(a), R1, warn_unstable=False)
-        return Yh
-
-    def predict(x):
-        a, b = arrays(theta_of(x[:n_eta]))
-        R = grid.apply(b, U) - V @ x[n_eta:]
-        return a, b, _full(solve(a, R), N)
-
-    def residual(x):
-        _, _, Yh = predict(x)
-        d = (Y - Yh)[lines] * w
-        return np.concatenate([d.real, d.imag])
-
-    def jacobian(x):
-        a, b, Yh = predict(x)
-        R = np.stack([grid.apply(bd, U) - grid.apply(ad, Yh) for ad, bd in dirs]
-                     + [-V[:, j] for j in range(nT)], axis=1)
-        R1 = solve(a, R)                       # (N/2+1, p): dY/dx on lines 0..N/2
-        D = R1[lines] * w[:, None]
-        return -np.concatenate([D.real, D.imag])
-
-    def fit(x_start):
-        try:
-            return least_squares(residual, x_start, jac=jacobian, method="lm",
-                                 max_nfev=max_iterations * (x_start.size + 1), xtol=1e-12, ftol=1e-12, gtol=1e-12)
-        except _core.NumericalError as e:
-            raise _core.NumericalError(f"the output-error fit met a singular model: {e}") from None
-
-    sol = fit(x0)
-    if isinstance(noise, str) and noise == "residual":
-        # the residual's local mean square, debiased for the parameters, then the fit again
-        n_par = x0.size
-        for _ in range(2):
-            _, _, Yh = predict(sol.x)
-            e2 = np.abs((Y - Yh)[lines]) ** 2
-            c = np.convolve(np.ones(2 * noise_width + 1), np.ones(lines.size), mode="same")
-            var = np.convolve(e2, np.ones(2 * noise_width + 1), mode="same") / c
-            var *= 2 * lines.size / (2 * lines.size - n_par)
-            var = np.maximum(var, 1e-300)
-            w = 1.0 / np.sqrt(var / 2.0)
-            sol = fit(sol.x)
-        noise_dof = 2 * noise_width + 1
-    x = sol.x
-    J = sol.jac
-    cost = float(np.sum(sol.fun**2))
-    try:
-        cov = np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = np.linalg.pinv(J.T @ J)
-    std = np.sqrt(np.clip(np.diag(cov), 0, None))
-    theta = theta_of(x[:n_eta])
-    a, b = arrays(theta)
-    model = Model(a, b, w0=float(w0), ts=ts)
-    _, _, Yh = predict(x)
-    eta = np.zeros(par.n_xi)
-    eta[free] = x[:n_eta]
-    eta[norm] = 1.0
-    cov_eta = np.zeros((par.n_xi, par.n_xi))
-    cov_eta[np.ix_(free, free)] = cov[:n_eta, :n_eta]
+    a = np.zeros((na + 1, 2 * Ka + 1), dtype=complex)
+    b = np.zeros((nb + 1, 2 * Kb + 1), dtype=complex)
+    for (is_a, order, k), v in zip(par.params, np.asarray(fit.theta)):
+        if is_a:
+            a[order, Ka + k] = v
+        else:
+            b[order, Kb + k] = v
+    cov_eta = np.asarray(fit.covariance)
     return RecordResult(
-        model=model, eta=eta, eta_names=list(par.eta_names), covariance=cov_eta,
-        parameter_std=np.sqrt(np.diag(cov_eta)), transient=x[n_eta:].copy(), transient_std=std[n_eta:], periods=L,
-        lines=lines, noise_var=var, noise_dof=int(noise_dof), Y=Y[lines], Y_fit=Yh[lines], cost=cost,
-        dof=int(2 * lines.size - x.size), converged=bool(sol.success), iterations=int(sol.nfev))
+        model=Model(a, b, w0=float(w0), ts=ts), eta=np.asarray(fit.eta), eta_names=list(par.eta_names),
+        covariance=cov_eta, parameter_std=np.sqrt(np.diag(cov_eta)), transient=np.asarray(fit.transient),
+        transient_std=np.asarray(fit.transient_std), periods=L, lines=lines, noise_var=var,
+        noise_dof=int(noise_dof), Y=Y[lines], Y_fit=np.asarray(fit.Y_fit), cost=float(fit.cost),
+        dof=int(fit.dof), converged=bool(fit.converged), iterations=int(fit.iterations))

@@ -342,3 +342,42 @@ DISTORTION_KAPPA_MAX = 1e3
 # carry their line's relative error (measured <= 3e-13), the BLA's far branches, a thousandth of
 # their line's coefficients, its absolute error (measured <= 3e-12).
 DISTORTION_RELATIVE = 1e-10
+
+
+# ==================================================================================================
+# One record with its transient: tests/python/test_record_core.py (the core's lptv::fit_record
+# against lptv.reference.record).
+# ==================================================================================================
+
+# The prediction A^-1 (B U - T) on the record's grid, the core (KLU on the whole grid) against
+# the reference (SuperLU per residue class of the lines modulo L), relative to the largest line:
+# the FDS_VS_REFERENCE argument, each a backward-stable LU with forward error ~ c eps kappa,
+# kappa Skeel's condition number of A, which the test computes per class and keeps below
+# RECORD_KAPPA_MAX: 2e3 x 2.2e-16 = 4.4e-13 per route at the bound. Measured: 3.5e-14 and
+# 4.0e-14 on the discrete-time example (kappa 1.4e3), 4.8e-16 on the first-order one (3.3).
+RECORD_PREDICTION = 1e-12
+RECORD_KAPPA_MAX = 2e3
+# The equation error's regression (M, e0), entry by entry relative to the magnitude of the
+# terms of its row (sum over the parameters of |z^n X|): each entry is one product or a sum of
+# two through Text, a few eps of the terms. Measured: below 1e-16.
+RECORD_REGRESSION = 1e-14
+# The estimates, core against reference, in units of each parameter's reported std. The two
+# routes stop at different points of the same minimum: MINPACK when the actual and predicted
+# decreases of the cost F (about 2 n = 1000 here) are below ftol F = 1e-12 F, i.e. a remaining
+# step of sqrt(1e-12 F) = 3e-5 std (the cost's curvature is 1 per std^2: J^T J is the inverse
+# covariance), and its trial costs carry the prediction's rounding, ~1e-11 F, so it cannot
+# resolve steps below sqrt(1e-11 F) = 1e-4 std; the core stops when the predicted decrease is
+# below 8 eps F (1.3e-6 std). The residual route chains three fits, each started from the last
+# and weighted by its residual, which carries the difference along. 1e-3 std leaves a factor 10
+# over the 1e-4 floor. Measured: at most 1.2e-5 std (eta), 1.5e-6 std (c).
+RECORD_STD_UNITS = 1e-3
+# What follows from RECORD_STD_UNITS = D: the prediction moves by at most D of its own std,
+# below D times the noise level (measured 1.9e-6 of sqrt(noise_var)); the residual's variance
+# |e|^2 by 2 |e| |de| <= 2 D relative, and the cost likewise (measured 4.8e-8 and 3.7e-10); the
+# reported std, the inverse of J^T J at points D std apart, by the change of J over D std: one
+# std is about 1e-4 of the coefficients' size (1.5e-5 to 3.9e-4 against 0.04 to 1.2 on the
+# discrete-time example), so J moves by about 1e-4 D relative; 1e-3 D leaves a factor 10
+# (measured 4e-9).
+RECORD_NOISE_VAR = 2 * RECORD_STD_UNITS
+RECORD_COST = 2 * RECORD_STD_UNITS
+RECORD_COVARIANCE = 1e-3 * RECORD_STD_UNITS

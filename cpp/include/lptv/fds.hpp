@@ -69,6 +69,9 @@ class Fds {
   Eigen::MatrixXcd solve_full(const Eigen::MatrixXcd& U) const;
   // Columns of the harmonic transfer function G = A^-1 B for the given input lines.
   Eigen::MatrixXcd htf_columns(const std::vector<int>& input_lines) const;
+  // A^-1 R for any full-grid right-hand sides R (grid.N rows, any number of columns): the one
+  // factorisation reused beyond B U (lptv::fit_record's prediction and its Jacobian columns).
+  Eigen::MatrixXcd solve_A(const Eigen::MatrixXcd& rhs) const;
 
  private:
   Model model_;
@@ -79,7 +82,7 @@ class Fds {
   std::unique_ptr<SparseLU> lu_;
   double condition_ = 0.0;
   int condition_line_ = 0;
-  Eigen::MatrixXcd solve_A(const Eigen::MatrixXcd& rhs) const;
+  Eigen::MatrixXcd solve_factored(const Eigen::MatrixXcd& rhs) const;
 };
 
 // One grid, one factorisation, the given inputs only (the factors are not kept): what
