@@ -13,6 +13,9 @@ system, the discrete-time system), number of periods P and method (WGTLS, SML):
 Each rate is given with its binomial standard error sqrt(p (1 - p) / R).
 
     python bench/python/bench_verdict.py --runs 400 --periods 4 8 16 32
+
+``--sample-variances`` judges the residues against each line's own sample (co)variances (the
+verdict before the moderated variances of METHOD.md section 7), for comparison.
 """
 from __future__ import annotations
 
@@ -60,7 +63,9 @@ def _structure(case, st):
 
 
 def one(args):
-    system, P, seed = args
+    system, P, seed, moderate = args
+    import lptv.verdict
+    lptv.verdict.MODERATE = moderate
     rng = np.random.default_rng([seed, P, SYSTEMS.index(system)])
     out = []
     base = system_measurements(system, seed=rng, periods=P)
@@ -95,12 +100,16 @@ def main(argv=None):
     ap.add_argument("--periods", type=int, nargs="+", default=[4, 8, 16, 32])
     ap.add_argument("--systems", nargs="+", default=["paper", "third_order", "discrete"])
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--sample-variances", action="store_true",
+                    help="judge against the lines' own sample variances (no moderation)")
     args = ap.parse_args(argv)
-    tasks = [(s, P, seed) for s in args.systems for P in args.periods for seed in range(args.runs)]
+    moderate = not args.sample_variances
+    tasks = [(s, P, seed, moderate) for s in args.systems for P in args.periods for seed in range(args.runs)]
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as ex:
         rows = [r for chunk in ex.map(one, tasks, chunksize=8) for r in chunk]
-    print(f"# {len(tasks)} realisations in {time.time() - t0:.0f} s; R = {args.runs} per cell")
+    print(f"# {len(tasks)} realisations in {time.time() - t0:.0f} s; R = {args.runs} per cell; "
+          f"{'moderated' if moderate else 'sample'} variances")
     print("| system | P | method | size (true structure) | power: extra 2 % harmonic | power: a0 one harmonic "
           "too few | power: missing order | errors |")
     print("|---|---|---|---|---|---|---|---|")

@@ -36,6 +36,7 @@ from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
                         multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
+from .moderation import ModeratedNoise, moderated_noise
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 
 __version__ = "0.1.0"
@@ -48,5 +49,5 @@ __all__ = [
     "select", "SelectionResult", "simulate", "spectrum", "time_signal", "check_record", "RecordCheck", "RecordWarning",
     "lti_table", "parameter_table", "compare", "freqresp_band",
     "CrestDesign", "ExcitationLines", "excitation_lines", "min_crest_multisine", "multisine_realisations",
-    "schroeder_multisine", "RecordResult", "identify_record",
+    "schroeder_multisine", "RecordResult", "identify_record", "ModeratedNoise", "moderated_noise",
 ]

@@ -31,6 +31,13 @@ from . import _core
 
 ALPHA = 0.01
 """Overall size of the residue tests (Holm's combination)."""
+MODERATE = True
+"""Judge the residues against noise (co)variances moderated across neighbouring lines
+(:func:`lptv.moderated_noise`, METHOD.md section 7); False: against each line's own sample
+(co)variances, as the fit weighs them (less power at small P; kept for comparison)."""
+SCORE_SLOPE = 0.9032
+"""E[d s / d log z] for z ~ Exp(1), s = Phi^-1(1 - exp(-z)) the normal score: the integral over u
+in (0, 1) of -log(1 - u) (1 - u) / phi(Phi^-1(u)) (by quadrature)."""
 SIGNAL_FALSE_RATE = 1e-3
 """A line counts as carrying signal when its power over its noise variance exceeds the
 quantile of the noise-only distribution that noise alone exceeds with this probability."""
@@ -139,6 +146,8 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     theta = np.asarray(res.theta)
     # Per experiment: its rows in sorted order, S (interleaved), the real Jacobian.
     order, S_blocks, J_blocks, nus, signal_rows, offsets = [], [], [], [], [], []
+    wfit = []     # per experiment: the variances the fit weighed its rows by (interleaved)
+    err_blocks = []   # per experiment: covariance of the rows' relative variance errors
     extensions = _extensions(structure, par)
     score_parts = {x: [] for x in extensions}    # per experiment: (s, F, Jf, Sdiag, P)
     for e, d in enumerate(datas):
@@ -149,6 +158,14 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         # nearly no leverage), and the dense residue covariance costs O(rows^2)
         P = int(d.periods)
         sig = _signal_lines(d, P)
+        # The tests divide by the moderated (co)variances, with their degrees of freedom per
+        # line; the fit weighed its rows by the sample ones (d_fit).
+        nu_line, d_fit = None, d
+        if MODERATE and P >= 2:
+            from .moderation import moderated_noise
+            mo = moderated_noise(d)
+            if mo.prior_dof > 0:
+                d, nu_line = mo.data, mo.dof
         rows_e = np.sort(lines[idx])
         near = np.zeros(rows_e.size, bool)
         for k in range(-K, K + 1):
@@ -159,8 +176,17 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         pos = {int(l): int(i) for l, i in zip(lines[idx], idx)}
         order.append(np.array([pos[int(l)] for l in srt]))
         S_blocks.append(np.asarray(like.residue_covariance(theta)))
+        err_blocks.append(mo.error_covariance(srt) if nu_line is not None else np.zeros((srt.size, srt.size)))
+        if d_fit is d:
+            wfit.append(np.diag(S_blocks[-1]))
+        else:   # WGTLS weighs Re and Im of row l alike, by 2 / var e_l
+            wfit.append(np.repeat(np.asarray(_core.residue_variance(d_fit._cpp, par, [int(l) for l in srt],
+                                                                     theta)), 2) / 2)
         J_blocks.append(_real_jacobian(np.asarray(_core.jacobian(d._cpp, par, [int(l) for l in srt])), T, free))
-        nus.append(np.full(srt.size, 2.0 * (P - 1) if P >= 2 else np.inf))
+        if nu_line is not None:   # a row reads lines l-K..l+K: the fewest of their dof (line 0 aside)
+            nus.append(np.array([nu_line[max(l - K, 1):l + K + 1].min() for l in srt]))
+        else:
+            nus.append(np.full(srt.size, 2.0 * (P - 1) if P >= 2 else np.inf))
         signal_rows.append(np.ones(srt.size, bool))
         ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
         offsets.append(_offset_groups(srt, ex))
@@ -168,7 +194,8 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         for x, par_x in extensions.items():
             part = _score_part(d, par_x, srt, res.model, sdiag)
             if part is not None:
-                score_parts[x].append(part + (P,))
+                # the periods the variances are worth: 1 + dof / 2
+                score_parts[x].append(part + (P if nu_line is None else 1.0 + float(nus[-1].min()) / 2,))
     if not order:
         return None
     order = np.concatenate(order)
@@ -189,7 +216,10 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     # over-subtracts on the rows next to the excited lines (their group's statistic had mean
     # -0.33 and standard deviation 0.66 on the discrete-time system, against -0.06 and 0.82 this
     # way); at P = 32 the two agree.
-    w = 1.0 / sd
+    # With moderated variances S is theirs while Pi keeps the weights the fit used: given those
+    # weights (independent of the periods' means for Gaussian noise) this S_r is the residue's
+    # first-order covariance.
+    w = 1.0 / np.concatenate(wfit)
     X = Jc @ np.linalg.pinv((Jc * w[:, None]).T @ Jc)         # Jc (Jc^T W Jc)^-1
     PiS = X @ ((Jc * w[:, None]).T @ S)                        # Pi S
     G = (Jc * w[:, None]).T @ S @ (Jc * w[:, None])
@@ -200,7 +230,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     sig2 = blocks[ii, 0, ii, 0] + blocks[ii, 1, ii, 1]
     v = sd[0::2] + sd[1::2]
     shrink = np.clip(sig2 / v, 0.05, None)
-    z = np.asarray(res.normalized_residue)[order] ** 2 / shrink
+    z = np.abs(np.asarray(res.residue)[order]) ** 2 / v / shrink
     nu = np.concatenate(nus)
     u = np.where(np.isfinite(nu), stats.f.cdf(z, 2, np.where(np.isfinite(nu), nu, 1.0)), -np.expm1(-z))
     score = stats.norm.ppf(np.clip(u, 1e-300, 1 - 1e-16))
@@ -213,6 +243,18 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     if not judged.any():
         judged = np.ones(m, bool)
     tests = []
+
+    # Moderated variances share their neighbours' sampling errors: rows near each other are
+    # judged against variances off together, which adds E[ds/dlog z]^2 Cov(delta_l, delta_l')
+    # to the scores' covariance (delta the rows' relative variance errors, taken as those of
+    # their own line; SCORE_SLOPE the mean slope of the normal score in log z).
+    E = np.zeros((m, m))
+    o = 0
+    for B in err_blocks:
+        E[o:o + B.shape[0], o:o + B.shape[0]] = B
+        o += B.shape[0]
+    np.fill_diagonal(E, 0.0)        # each row's own error is in its F(2, nu) already
+    corr = corr + SCORE_SLOPE ** 2 * E
 
     def stat(mask):
         s = score[mask].sum()

@@ -313,6 +313,23 @@ def python_cases():
         Case("spectrum-x-nan", "nan/inf", lambda: lp().spectrum([0.0, NaN]), match=names("x")),
         Case("spectrum-x-complex", "type", lambda: lp().spectrum([1j, 1.0]), match=names("x")),
     ]
+    # noise variances moderated across lines
+    def mod_fd(L=100):
+        rng = np.random.default_rng(0)
+        u = rng.standard_normal((4, 2 * L))
+        return lp().FrequencyData.from_periods(u, 2 * u + 0.1 * rng.standard_normal((4, 2 * L)), w0=1.0)
+
+    C += [
+        Case("moderated_noise-data-array", "type", lambda: lp().moderated_noise(np.ones(10)), match=names("data")),
+        Case("moderated_noise-half_width-zero", "range", lambda: lp().moderated_noise(mod_fd(), 0),
+             match=names("half_width")),
+        Case("moderated_noise-half_width-str", "type", lambda: lp().moderated_noise(mod_fd(), "3"),
+             match=names("half_width")),
+        Case("moderated_noise-half_width-2**63", "overflow", lambda: lp().moderated_noise(mod_fd(), 2**63),
+             match=with_value("half_width", 2**63)),
+        Case("moderated_noise-few-lines", "value", lambda: lp().moderated_noise(mod_fd(12)),
+             check=lambda m: m.prior_dof == 0 and np.all(m.dof[1:-1] == 6)),
+    ]
     # one record with its transient
     def rec():
         from lptv.examples import discrete_model, transient_record

@@ -1,0 +1,145 @@
+"""Noise variances moderated across neighbouring lines (lptv.moderated_noise, METHOD.md section 7).
+
+The distributional claims are checked on noise whose variance is known line by line: the
+moderated variance of a line is then judged against the true one, and a mean's |X|^2 over its
+moderated variance must follow F(2, dof) when the model of the rule (a smooth trend, a scaled
+inverse chi-square spread about it) holds."""
+import numpy as np
+import pytest
+from scipy import stats
+
+import lptv
+
+
+def _data(var_u, var_y, P, seed, rho=0.0):
+    """FrequencyData of P periods of pure noise with the given variances of one period's line
+    (lines 1..L), output correlated with the input by rho: the spectra are the noise's means."""
+    rng = np.random.default_rng(seed)
+    L = var_y.size - 1
+    N = 2 * L
+    def noise(var):
+        X = (rng.standard_normal((P, L + 1)) + 1j * rng.standard_normal((P, L + 1))) * np.sqrt(var / 2)
+        return X
+    Eu, Ey = noise(np.ones(L + 1)), noise(np.ones(L + 1))
+    Ey = rho * Eu + np.sqrt(1 - rho ** 2) * Ey
+    Eu, Ey = Eu * np.sqrt(var_u), Ey * np.sqrt(var_y)
+    Eu[:, 0], Ey[:, 0] = Eu[:, 0].real, Ey[:, 0].real
+    Eu[:, -1], Ey[:, -1] = Eu[:, -1].real, Ey[:, -1].real
+    # time signals whose spectra (lptv.spectrum's scaling) are these lines
+    u = np.array([lptv.time_signal(x, N) for x in Eu])
+    y = np.array([lptv.time_signal(x, N) for x in Ey])
+    return lptv.FrequencyData.from_periods(u, y, w0=1.0)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_smooth_noise_is_moderated_to_near_its_true_variance(seed):
+    """White noise at P = 4: the sample variance of one line is off by its chi-square_6 / 6 spread
+    (relative error 0.58 rms); moderated over +-10 lines the error is that of about 20 lines'
+    pool, below 0.25 rms, and d0 is large."""
+    L = 400
+    d = _data(np.full(L + 1, 0.01), np.full(L + 1, 0.04), 4, seed)
+    mod = lptv.moderated_noise(d)
+    inner = np.arange(1, L)
+    truth_y = 0.04 / 4                   # the variance of the mean of 4 periods
+    own = d.varY[inner] / truth_y - 1
+    moderated = np.asarray(mod.data.varY)[inner] / truth_y - 1
+    assert np.sqrt(np.mean(own ** 2)) > 0.45
+    assert np.sqrt(np.mean(moderated ** 2)) < 0.25
+    assert mod.prior_dof > 20
+    assert np.median(mod.dof[inner]) > 40
+    assert mod.dof[0] == 3 and mod.dof[L] == 3
+
+
+def test_moderated_statistic_follows_F_with_the_stated_degrees_of_freedom():
+    """Noise whose variance follows a smooth trend (two decades over the band) times a scaled
+    inverse chi-square spread with 30 degrees of freedom, P = 4, over 40 data sets: the means'
+    |X|^2 over their moderated variance, mapped through F(2, dof), are uniform: the fractions
+    beyond the 90 %, 99 % points are 10 %, 1 % within 4 binomial standard errors (n = 40 x 598
+    lines, rows of one data set sharing a prior: the bounds are generous by a factor 2)."""
+    L = 300
+    l = np.arange(L + 1)
+    trend = 0.01 * 10 ** (2 * l / L)
+    u90, u99, n = 0, 0, 0
+    d0s = []
+    for seed in range(40):
+        rng = np.random.default_rng(1000 + seed)
+        spread = 30 / rng.chisquare(30, (2, L + 1))
+        d = _data(trend * spread[0], trend * spread[1], 4, seed)
+        mod = lptv.moderated_noise(d)
+        d0s.append(mod.prior_dof)
+        inner = np.setdiff1d(np.arange(1, L), mod.outliers)
+        for X, v in ((d.U, mod.data.varU), (d.Y, mod.data.varY)):
+            z = np.abs(np.asarray(X)[inner]) ** 2 / np.asarray(v)[inner]
+            p = stats.f.sf(z, 2, mod.dof[inner])
+            u90 += np.sum(p < 0.10)
+            u99 += np.sum(p < 0.01)
+            n += inner.size
+    assert 10 < np.median(d0s) < 120, d0s          # the spread's 30, from one data set each
+    se90, se99 = np.sqrt(0.09 / n), np.sqrt(0.0099 / n)
+    assert abs(u90 / n - 0.10) < 8 * se90, u90 / n
+    assert abs(u99 / n - 0.01) < 8 * se99, u99 / n
+
+
+def test_rough_noise_keeps_each_line_near_its_own_variance():
+    """Variances drawn independently per line over two decades: the neighbours know nothing,
+    d0 comes out small and the line's own variance dominates: the spread's log-variance variance
+    (2 ln 10)^2 / 12 = 1.77 is trigamma(0.7), d0 = 1.4, raised a little by the lines flagged as
+    above their neighbours (left out of the spread); the own weight d / (d + d0) stays above 2/3
+    for d = 2 (P - 1) = 14."""
+    L = 300
+    rng = np.random.default_rng(5)
+    v = 10 ** rng.uniform(-3, -1, (2, L + 1))
+    d = _data(v[0], v[1], 8, 6)
+    mod = lptv.moderated_noise(d)
+    assert mod.prior_dof < 7
+    inner = np.arange(1, L)
+    assert np.median(mod.dof[inner]) < 20
+    w = np.asarray(mod.data.varY)[inner] / d.varY[inner]
+    assert np.median(np.abs(w - 1)) < 0.3
+
+
+def test_a_narrowband_disturbance_keeps_its_own_variance():
+    """One line with 200 times the noise of its neighbours (a disturbance between the grid's
+    lines): flagged, its variance kept as measured, and left out of its neighbours' prior."""
+    L = 300
+    vy = np.full(L + 1, 0.01)
+    vy[150] = 2.0
+    d = _data(np.full(L + 1, 0.01), vy, 4, 7)
+    mod = lptv.moderated_noise(d)
+    assert 150 in mod.outliers
+    assert mod.data.varY[150] == d.varY[150]
+    assert mod.dof[150] == 6
+    assert mod.data.varY[149] < 5 * np.median(d.varY)
+    assert mod.prior_dof > 20
+
+
+def test_correlated_input_and_output_noise_keeps_a_valid_covariance():
+    L = 200
+    d = _data(np.full(L + 1, 0.01), np.full(L + 1, 0.02), 4, 8, rho=0.6)
+    mod = lptv.moderated_noise(d)
+    m = mod.data
+    assert np.all(np.abs(m.covYU) ** 2 <= m.varU * m.varY * (1 + 1e-12))
+    inner = np.arange(1, L)
+    rho = np.abs(np.asarray(m.covYU)[inner]) / np.sqrt(np.asarray(m.varU)[inner] * np.asarray(m.varY)[inner])
+    assert abs(np.median(rho) - 0.6) < 0.1
+
+
+def test_data_that_cannot_be_moderated_are_returned_unchanged():
+    d = _data(np.full(21, 0.01), np.full(21, 0.01), 4, 9)        # 20 lines < 3 x 10 + 2
+    mod = lptv.moderated_noise(d)
+    assert mod.prior_dof == 0 and mod.data is d
+    assert np.all(mod.dof[1:-1] == 6)
+    given = lptv.FrequencyData(d.U, d.Y, d.varU, d.varY, w0=1.0)     # periods = 0
+    assert lptv.moderated_noise(given).prior_dof == 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (("not data",), "data must be an lptv.FrequencyData"),
+    ((None, 0), "half_width"),
+    ((None, 2.5), "half_width"),
+])
+def test_bad_arguments_name_themselves(args, message):
+    d = _data(np.full(101, 0.01), np.full(101, 0.01), 4, 10)
+    args = tuple(d if a is None else a for a in args)
+    with pytest.raises(ValueError, match=message):
+        lptv.moderated_noise(*args)
