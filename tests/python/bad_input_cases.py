@@ -624,7 +624,13 @@ def python_cases():
           Case("identify-covariance-bogus", "value", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
                covariance="jackknife"), match=names("covariance")),
           Case("identify-bootstrap-5", "range", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
-               covariance="bootstrap", bootstrap=5), match=names("bootstrap"))]
+               covariance="bootstrap", bootstrap=5), match=names("bootstrap")),
+          Case("identify-noise-bogus", "value", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               noise="smoothed"), match=names("noise")),
+          Case("identify-noise-int", "type", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               noise=1), match=names("noise")),
+          Case("identify-noise-moderated-bootstrap", "value", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               noise="moderated", covariance="bootstrap"), match=names("noise"))]
 
     C += family("floquet", "tol", lambda v: lp().floquet(ltv(), tol=v), FLOAT_BAD)
     C += family("floquet", "min_truncation", lambda v: lp().floquet(ltv(), min_truncation=v), INT_BAD)
@@ -911,6 +917,7 @@ def cli_cases():
         add(f"identify-known-{v}", ok + ("--known", v), "--known")
     add("identify-method-bogus", ok + ("--method", "ml"), "--method")
     add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
+    add("identify-noise-bogus", ok + ("--noise", "smooth"), "--noise")
     for v in ("5", "abc") + big:
         add(f"identify-bootstrap-{v}", ok + ("--bootstrap", v), "--bootstrap")
     add("identify-out-proc", ok + ("--out", "/proc/nope"), "/proc/nope")

@@ -409,3 +409,26 @@ def test_bootstrap_covariance_option(small, tmp_path, capsys):
     rc, out, err = identify_cli(capsys, src, src, "--na", 1, "--nb", 0, "--ts", TS,
                                 "--covariance", "bootstrap")
     assert rc == 2 and "one record at a time" in err and err.count("\n") == 1
+
+
+def test_moderated_noise_option(tmp_path, capsys):
+    """--noise moderated gives the Python API's fit with noise='moderated' (model.json, and the
+    summary says which noise); with several files it is refused in one line."""
+    import json
+
+    from lptv.examples import system_measurements
+
+    d = system_measurements("discrete", seed=2, periods=4)
+    src = tmp_path / "dt.npz"
+    np.savez(src, u=d["u"], y=d["y"])
+    st = d["structure"]
+    args = ["--na", st["na"], "--nb", st["nb"], "--ka", ",".join(map(str, st["ka"])),
+            "--kb", ",".join(map(str, st["kb"])), "--ts", 1.0, "--method", "sml"]
+    rc, out, err = identify_cli(capsys, src, *args, "--noise", "moderated", "--out", tmp_path / "o")
+    assert rc == 0, err
+    ref = lptv.identify(d["u"], d["y"], **st, w0=d["w0"], ts=1.0, method="sml", noise="moderated")
+    model = lptv.Model.load(tmp_path / "o" / "model.json")
+    np.testing.assert_allclose(model.covariance, ref.covariance, rtol=1e-9, atol=0)
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["noise"] == "moderated"
+    rc, out, err = identify_cli(capsys, src, src, *args, "--noise", "moderated")
+    assert rc == 2 and "--noise moderated takes one record" in err and err.count("\n") == 1

@@ -143,3 +143,61 @@ def test_bad_arguments_name_themselves(args, message):
     args = tuple(d if a is None else a for a in args)
     with pytest.raises(ValueError, match=message):
         lptv.moderated_noise(*args)
+
+
+# ------------------------------------------------------------------ fits weighed by moderated noise
+
+def _system(name="discrete", seed=3, P=4):
+    from lptv.examples import system_measurements
+    return system_measurements(name, seed=seed, periods=P)
+
+
+def _fit(d, **kw):
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], ts=d["ts"], lines=d["lines"], **kw)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_identify_with_moderated_noise_weighs_by_it_and_reports_its_periods(seed):
+    """noise='moderated': the fit uses the moderated (co)variances (res.data holds them, with the
+    periods they are worth), agrees with the sample-weighted fit within their uncertainty, and
+    its verdict reads the fit's own moderation (not a second one)."""
+    d = _system(seed=seed)
+    ref = _fit(d, method="sml")
+    res = _fit(d, method="sml", noise="moderated")
+    assert res.noise == "moderated" and ref.noise == "sample" and ref.moderation == ()
+    mo = res.moderation[0]
+    assert isinstance(mo, lptv.ModeratedNoise)
+    assert np.array_equal(res.data.varY, mo.data.varY)
+    assert res.data.periods == round(1 + np.median(mo.dof[1:-1]) / 2) > 4
+    free = res.parameter_std > 0
+    z = (res.eta - ref.eta)[free] / np.hypot(res.parameter_std, ref.parameter_std)[free]
+    assert np.max(np.abs(z)) < 3.5, z
+    assert res.residue_tests is not None and res.model_ok
+
+
+def test_the_verdict_of_a_moderated_fit_does_not_moderate_again(monkeypatch):
+    import lptv.moderation
+    d = _system(seed=4)
+    res = _fit(d, method="wgtls", noise="moderated")
+    calls = []
+    real = lptv.moderation.moderated_noise
+    monkeypatch.setattr(lptv.moderation, "moderated_noise", lambda *a, **k: calls.append(1) or real(*a, **k))
+    assert res.residue_tests is not None
+    assert calls == []
+    ref = _fit(d, method="wgtls")
+    assert ref.residue_tests is not None and calls == [1]
+
+
+def test_moderated_noise_with_several_experiments():
+    d1, d2 = _system(seed=5), _system(seed=6, P=6)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = lptv.identify([(d1["u"], d1["y"]), (d2["u"], d2["y"])], **d1["structure"], w0=d1["w0"],
+                            ts=d1["ts"], method="sml", noise="moderated")
+    assert len(res.moderation) == 2 and all(isinstance(m, lptv.ModeratedNoise) for m in res.moderation)
+    assert res.experiments[0].periods > 4 and res.experiments[1].periods > 6
+    assert res.residue_tests is not None

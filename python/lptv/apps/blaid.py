@@ -48,6 +48,9 @@ def _fail(src, problem) -> int:
 
 def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     M, P, N = meas.u.shape
+    if getattr(args, "noise", "sample") != "sample":
+        return _fail(src, "--noise moderated is for records of periods, not M x P x N realisations (their "
+                          "variances are the noise's and the nonlinear distortion's, per realisation)")
     if getattr(args, "covariance", "analytic") != "analytic":
         return _fail(src, "--covariance bootstrap takes one record of periods, not M x P x N realisations "
                           "(their covariance includes the nonlinear distortion analytically)")

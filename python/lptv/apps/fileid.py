@@ -198,6 +198,10 @@ def add_parser(sub):
                    "bootstrap of --bootstrap refits (one record; better calibrated at few periods)")
     p.add_argument("--bootstrap", type=int, default=200, metavar="B",
                    help="refits for --covariance bootstrap (default 200)")
+    p.add_argument("--noise", default="sample", choices=("sample", "moderated"),
+                   help="the noise variances the fit weighs by: each line's own from its periods (default), "
+                   "or moderated across neighbouring lines (smooth noise spectra; more precise estimates and "
+                   "calibrated intervals at few periods; one record or --joint)")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
@@ -223,7 +227,7 @@ def _one_line(problem) -> str:
 
 OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_iter": "--max-iter",
                 "tol": "--tol", "lines": "--lines", "known": "--known", "method": "--method", "w0": "--w0",
-                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap"}
+                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap", "noise": "--noise"}
 """The arguments of lptv.identify and the options that set them, for the messages."""
 
 
@@ -239,6 +243,11 @@ def run(args) -> int:
                                           or args.scheduler is not None):
         print("lptv identify: error: --covariance bootstrap takes one record at a time (not several files, "
               "--joint, --workers or --scheduler)", file=sys.stderr)
+        return 2
+    if args.noise != "sample" and not args.joint and (len(args.files) > 1 or args.workers is not None
+                                                      or args.scheduler is not None):
+        print("lptv identify: error: --noise moderated takes one record or --joint (not a batch of files, "
+              "--workers or --scheduler)", file=sys.stderr)
         return 2
     if args.resume and (args.joint or (len(args.files) == 1 and args.workers is None and args.scheduler is None)):
         print("lptv identify: error: --resume applies to a batch of files (several files, --workers or "
@@ -284,7 +293,7 @@ def run(args) -> int:
             res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
                            max_iter=args.max_iter, covariance=args.covariance, bootstrap=args.bootstrap,
-                           seed=0)
+                           seed=0, noise=args.noise)
             Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
@@ -320,7 +329,7 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
     return {
         "file": str(args.files[0]), "format": meas.format, "periods": P, "samples_per_period": N,
         "w0": w0, "ts": args.ts, "na": res.model.na, "nb": res.model.nb,
-        "ka": ka, "kb": kb, "method": res.method,
+        "ka": ka, "kb": kb, "method": res.method, "noise": res.noise,
         "n_lines": int(res.lines.size), "first_line": int(res.lines.min()),
         "last_line": int(res.lines.max()), "n_free_parameters": res.n_free_parameters,
         "iterations": res.iterations, "converged": res.converged, "cost": res.cost,
