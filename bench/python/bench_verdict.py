@@ -14,7 +14,8 @@ Each rate is given with its binomial standard error sqrt(p (1 - p) / R).
 
     python bench/python/bench_verdict.py --runs 400 --periods 4 8 16 32
 
-``--sample-variances`` judges the residues against each line's own sample (co)variances (the
+``--noise moderated`` fits with ``lptv.identify(..., noise='moderated')`` (the verdict then reads
+the fit's own moderated variances). ``--sample-variances`` judges the residues against each line's own sample (co)variances (the
 verdict before the moderated variances of METHOD.md section 7), for comparison.
 """
 from __future__ import annotations
@@ -63,7 +64,7 @@ def _structure(case, st):
 
 
 def one(args):
-    system, P, seed, moderate = args
+    system, P, seed, moderate, noise = args
     import lptv.verdict
     lptv.verdict.MODERATE = moderate
     rng = np.random.default_rng([seed, P, SYSTEMS.index(system)])
@@ -83,7 +84,7 @@ def one(args):
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     r = lptv.identify(d["u"], d["y"], **st, w0=d["w0"], ts=d["ts"], lines=d["lines"],
-                                      method=method)
+                                      method=method, noise=noise)
                     ok = r.model_ok
                     rt = r.residue_tests
                     reason = ("residue" if rt is not None and rt.rejected else
@@ -100,16 +101,18 @@ def main(argv=None):
     ap.add_argument("--periods", type=int, nargs="+", default=[4, 8, 16, 32])
     ap.add_argument("--systems", nargs="+", default=["paper", "third_order", "discrete"])
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--noise", default="sample", choices=("sample", "moderated"),
+                    help="the noise the fits weigh by (lptv.identify's noise=)")
     ap.add_argument("--sample-variances", action="store_true",
                     help="judge against the lines' own sample variances (no moderation)")
     args = ap.parse_args(argv)
     moderate = not args.sample_variances
-    tasks = [(s, P, seed, moderate) for s in args.systems for P in args.periods for seed in range(args.runs)]
+    tasks = [(s, P, seed, moderate, args.noise) for s in args.systems for P in args.periods for seed in range(args.runs)]
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as ex:
         rows = [r for chunk in ex.map(one, tasks, chunksize=8) for r in chunk]
     print(f"# {len(tasks)} realisations in {time.time() - t0:.0f} s; R = {args.runs} per cell; "
-          f"{'moderated' if moderate else 'sample'} variances")
+          f"verdict on {'moderated' if moderate else 'sample'} variances; fits weighed by {args.noise} noise")
     print("| system | P | method | size (true structure) | power: extra 2 % harmonic | power: a0 one harmonic "
           "too few | power: missing order | errors |")
     print("|---|---|---|---|---|---|---|---|")
