@@ -43,6 +43,8 @@ def main():
     ap.add_argument("--runs", type=int, default=300)
     ap.add_argument("--periods", type=int, nargs="+", default=None)
     ap.add_argument("--continuous", action="store_true", help="the continuous-time third-order example")
+    ap.add_argument("--known-noise", action="store_true",
+                    help="give the fits the true noise variance (separates the residual noise model's part)")
     args = ap.parse_args()
     if args.continuous:
         m = third_order_model()
@@ -71,7 +73,7 @@ def main():
         t0 = time.perf_counter()
         for _ in range(args.runs):
             y = y0 + NOISE * rng.standard_normal(N)
-            r = lptv.identify_record(u, y, **kw)
+            r = lptv.identify_record(u, y, **kw, **(dict(noise=true_var) if args.known_noise else {}))
             e = r.eta[free]
             s = r.parameter_std[free]
             est.append(e)
