@@ -31,12 +31,24 @@ std::string str(long long v) { return std::to_string(v); }
 // bookkeeping and the record's spectra: what every row of the fit reads.
 class RecordProblem {
  public:
-  RecordProblem(const Parametrisation& p, const RecordData& d, bool transient) : p_(p), d_(d) {
+  RecordProblem(const Parametrisation& p, const RecordData& d, bool transient, int transient_degree)
+      : p_(p), d_(d) {
     const Structure& s = p.structure();
-    if (!(s.ts > 0)) {
-      throw std::invalid_argument("ts: the single-record route is discrete time only (the structure has ts = 0)");
+    ct_ = !(s.ts > 0);
+    if (ct_) {
+      if (!(d.ts > 0 && std::isfinite(d.ts))) {
+        throw std::invalid_argument("ts: a continuous-time record needs its sample time (> 0), got " +
+                                    std::to_string(d.ts));
+      }
+      ts_ = d.ts;
+    } else {
+      if (d.ts != 0 && d.ts != s.ts) {
+        throw std::invalid_argument("ts: the record's sample time " + std::to_string(d.ts) +
+                                    " differs from the discrete-time structure's " + std::to_string(s.ts));
+      }
+      ts_ = s.ts;
     }
-    const double n0 = 2.0 * M_PI / (s.w0 * s.ts);
+    const double n0 = 2.0 * M_PI / (s.w0 * ts_);
     const double n0r = std::round(n0);
     if (!(n0r >= 2 && n0r <= 2147483647.0) || std::abs(n0 - n0r) > 1e-9 * n0r) {
       throw std::invalid_argument("w0 and ts must give a whole number of samples per period, 2 pi / (w0 ts) = " +
@@ -61,7 +73,18 @@ class RecordProblem {
     N_ = static_cast<int>(d.U.size());
     L_ = d.periods;
     order_ = std::max(s.na, s.nb);
-    nT_ = transient ? order_ : 0;
+    if (!ct_ && transient_degree != -1) {
+      throw std::invalid_argument("transient_degree: discrete time takes only -1 (the term z^1..z^n is exact), got " +
+                                  str(transient_degree));
+    }
+    if (ct_ && transient_degree != -1 && (transient_degree < order_ - 1 || transient_degree > order_ + 20)) {
+      throw std::invalid_argument("transient_degree must lie in " + str(order_ - 1) + ".." + str(order_ + 20) +
+                                  " (n - 1 .. n + 20) or be -1, got " + str(transient_degree));
+    }
+    // Discrete time: T = sum_{j=1}^{n} c_j z^j. Continuous time: T = sum_{j=0}^{d} c_j (j w ts)^j.
+    t0_ = ct_ ? 0 : 1;
+    const int tdeg = ct_ ? (transient_degree == -1 ? order_ + 1 : transient_degree) : order_;
+    nT_ = transient ? tdeg - t0_ + 1 : 0;
     free_ = p.free_indices();
     nf_ = static_cast<int>(free_.size());
     norm_ = p.norm_index();
@@ -70,9 +93,28 @@ class RecordProblem {
     // The record model's fundamental: the same double that its Fds builds A from, so the rows
     // here and the FDS's entries use the same z_i.
     w0_rec_ = s.w0 / L_;
-    zp_.resize(static_cast<size_t>(N_) * (order_ + 1));
-    for (int i = 0; i < N_; ++i) {
-      detail::line_powers(detail::line_variable(w0_rec_, s.ts, i), order_, &zp_[static_cast<size_t>(i) * (order_ + 1)]);
+    // The work grid: discrete time the circular N lines (index = DFT index); continuous time
+    // the lines -M..M at index l + M (the DFT's index l mod N), M = (N - 1) / 2.
+    M_ = (N_ - 1) / 2;
+    G_ = ct_ ? 2 * M_ + 1 : N_;
+    U_.resize(G_);
+    Y_.resize(G_);
+    for (int g = 0; g < G_; ++g) {
+      const int i = ct_ ? ((g - M_) % N_ + N_) % N_ : g;
+      U_[g] = d.U[i];
+      Y_[g] = d.Y[i];
+    }
+    zp_.resize(static_cast<size_t>(G_) * (order_ + 1));
+    tp_.resize(static_cast<size_t>(G_) * (nT_ + 1));
+    for (int g = 0; g < G_; ++g) {
+      const int line = ct_ ? g - M_ : g;
+      detail::line_powers(detail::line_variable(w0_rec_, ct_ ? 0.0 : s.ts, line), order_,
+                          &zp_[static_cast<size_t>(g) * (order_ + 1)]);
+      // the transient's basis: z^t0 .. z^(t0 + nT - 1), (j w ts)^j in continuous time
+      const cd v = ct_ ? cd(0.0, 2.0 * M_PI * line / N_) : zp_[static_cast<size_t>(g) * (order_ + 1) + 1];
+      cd pw(1.0, 0.0);
+      for (int j = 0; j < t0_; ++j) pw *= v;
+      for (int j = 0; j < nT_; ++j, pw *= v) tp_[static_cast<size_t>(g) * (nT_ + 1) + j] = pw;
     }
   }
 
@@ -97,7 +139,14 @@ class RecordProblem {
     }
   }
 
-  int N() const { return N_; }
+  int N() const { return G_; }  // lines of the work grid
+  bool continuous() const { return ct_; }
+  // Work-grid index of a (positive) fitted line.
+  int index(int l) const { return ct_ ? l + M_ : l; }
+  const Eigen::VectorXcd& U() const { return U_; }
+  const Eigen::VectorXcd& Y() const { return Y_; }
+  // The transient's basis at work-grid index g: nT entries.
+  const cd* t(int g) const { return &tp_[static_cast<size_t>(g) * (nT_ + 1)]; }
   int n_free() const { return nf_; }
   int n_transient() const { return nT_; }
   int n_par() const { return nf_ + nT_; }
@@ -107,8 +156,13 @@ class RecordProblem {
   const RecordData& data() const { return d_; }
   // z_i^0 .. z_i^order.
   const cd* z(int i) const { return &zp_[static_cast<size_t>(i) * (order_ + 1)]; }
-  // The line a harmonic k brings to line l: l - k L on the circular grid.
+  // The line a harmonic k brings to line l: l - k L on the circular grid; continuous time
+  // (work-grid indices) -1 beyond -M..M, where the FDS takes the spectra as zero.
   int source(int l, int k) const {
+    if (ct_) {
+      const int i = l - k * L_;
+      return i < 0 || i >= G_ ? -1 : i;
+    }
     const int i = (l - k * L_) % N_;
     return i < 0 ? i + N_ : i;
   }
@@ -119,8 +173,12 @@ class RecordProblem {
     for (int q = 0; q < p_.n_theta(); ++q) {
       const Param& pr = p_.params()[static_cast<size_t>(q)];
       const int i = source(l, pr.k);
+      if (i < 0) {
+        jrow[q] = cd(0.0, 0.0);
+        continue;
+      }
       const cd f = z(i)[pr.order];
-      jrow[q] = pr.is_a ? f * X[i] : -f * d_.U[i];
+      jrow[q] = pr.is_a ? f * X[i] : -f * U_[i];
     }
     std::fill(xrow, xrow + p_.n_xi(), cd(0.0, 0.0));
     for (const detail::TextEntry& e : text_) xrow[e.c] += jrow[e.p] * e.v;
@@ -144,21 +202,25 @@ class RecordProblem {
       const Param& pr = p_.params()[static_cast<size_t>(q)];
       if (pr.is_a) a(pr.order, (Ka_ + pr.k) * L_) = theta[q];
     }
-    return Model(std::move(a), Eigen::MatrixXcd::Constant(1, 1, cd(1.0, 0.0)), w0_rec_, s.ts);
+    return Model(std::move(a), Eigen::MatrixXcd::Constant(1, 1, cd(1.0, 0.0)), w0_rec_, ct_ ? 0.0 : s.ts);
+  }
+  // Its FDS: the circular grid, or continuous time the lines -M..M.
+  std::unique_ptr<Fds> fds(const Eigen::VectorXcd& theta) const {
+    return std::make_unique<Fds>(record_model(theta), ct_ ? M_ : 0, Solver::KLU);
   }
 
-  // B(theta) U - T(c) on all N lines.
+  // B(theta) U - T(c) on the work grid.
   Eigen::VectorXcd forcing(const Eigen::VectorXcd& theta, const Eigen::VectorXd& x) const {
-    Eigen::VectorXcd r(N_);
-    for (int l = 0; l < N_; ++l) {
+    Eigen::VectorXcd r(G_);
+    for (int l = 0; l < G_; ++l) {
       cd v(0.0, 0.0);
       for (int q = 0; q < p_.n_theta(); ++q) {
         const Param& pr = p_.params()[static_cast<size_t>(q)];
         if (pr.is_a) continue;
         const int i = source(l, pr.k);
-        v += theta[q] * z(i)[pr.order] * d_.U[i];
+        if (i >= 0) v += theta[q] * z(i)[pr.order] * U_[i];
       }
-      for (int j = 1; j <= nT_; ++j) v -= x[nf_ + j - 1] * z(l)[j];
+      for (int j = 0; j < nT_; ++j) v -= x[nf_ + j] * t(l)[j];
       r[l] = v;
     }
     return r;
@@ -167,11 +229,13 @@ class RecordProblem {
  private:
   const Parametrisation& p_;
   const RecordData& d_;
-  int N0_ = 0, N_ = 0, L_ = 1, order_ = 0, nT_ = 0, nf_ = 0, norm_ = 0, Ka_ = 0;
-  double w0_rec_ = 0;
+  bool ct_ = false;
+  int N0_ = 0, N_ = 0, L_ = 1, order_ = 0, nT_ = 0, t0_ = 1, nf_ = 0, norm_ = 0, Ka_ = 0, M_ = 0, G_ = 0;
+  double w0_rec_ = 0, ts_ = 0;
   std::vector<int> free_;
   std::vector<detail::TextEntry> text_;
-  std::vector<cd> zp_;
+  std::vector<cd> zp_, tp_;
+  Eigen::VectorXcd U_, Y_;
 };
 
 // x = V S^+ U^T b and V S^+2 V^T for a tall A (rows >= cols): a QR of A, then the SVD of its R;
@@ -223,14 +287,14 @@ class OutputError {
     Point pt;
     const Eigen::VectorXcd theta = pb_.theta_of(x);
     ++evaluations;
-    pt.fds = std::make_unique<Fds>(pb_.record_model(theta), 0, Solver::KLU);
+    pt.fds = pb_.fds(theta);
     pt.Yh = pt.fds->solve_A(pb_.forcing(theta, x));
     const auto& lines = pb_.data().lines;
     const Eigen::Index n = static_cast<Eigen::Index>(lines.size());
     pt.r.resize(2 * n);
     for (Eigen::Index i = 0; i < n; ++i) {
-      const int l = lines[static_cast<size_t>(i)];
-      const cd e = pb_.data().Y[l] - pt.Yh[l];
+      const int l = pb_.index(lines[static_cast<size_t>(i)]);
+      const cd e = pb_.Y()[l] - pt.Yh[l];
       pt.r[i] = w_[i] * e.real();
       pt.r[n + i] = w_[i] * e.imag();
     }
@@ -249,14 +313,14 @@ class OutputError {
     for (int l = 0; l < N; ++l) {
       pb_.xi_row(pt.Yh, l, jrow.data(), xrow.data());
       for (int c = 0; c < nf; ++c) rhs(l, c) = -xrow[static_cast<size_t>(pb_.free()[static_cast<size_t>(c)])];
-      for (int j = 1; j <= nT; ++j) rhs(l, nf + j - 1) = -pb_.z(l)[j];
+      for (int j = 0; j < nT; ++j) rhs(l, nf + j) = -pb_.t(l)[j];
     }
     const Eigen::MatrixXcd D = pt.fds->solve_A(rhs);
     const auto& lines = pb_.data().lines;
     const Eigen::Index n = static_cast<Eigen::Index>(lines.size());
     Eigen::MatrixXd J(2 * n, nf + nT);
     for (Eigen::Index i = 0; i < n; ++i) {
-      const int l = lines[static_cast<size_t>(i)];
+      const int l = pb_.index(lines[static_cast<size_t>(i)]);
       J.row(i) = -w_[i] * D.row(l).real();
       J.row(n + i) = -w_[i] * D.row(l).imag();
     }
@@ -398,10 +462,10 @@ RecordRegression regression(const Parametrisation& p, const RecordProblem& pb) {
   RecordRegression out{Eigen::MatrixXcd(n, nf + nT), Eigen::VectorXcd(n)};
   std::vector<cd> jrow(static_cast<size_t>(p.n_theta())), xrow(static_cast<size_t>(p.n_xi()));
   for (Eigen::Index i = 0; i < n; ++i) {
-    const int l = lines[static_cast<size_t>(i)];
-    pb.xi_row(pb.data().Y, l, jrow.data(), xrow.data());
+    const int l = pb.index(lines[static_cast<size_t>(i)]);
+    pb.xi_row(pb.Y(), l, jrow.data(), xrow.data());
     for (int c = 0; c < nf; ++c) out.M(i, c) = xrow[static_cast<size_t>(pb.free()[static_cast<size_t>(c)])];
-    for (int j = 1; j <= nT; ++j) out.M(i, nf + j - 1) = pb.z(l)[j];
+    for (int j = 0; j < nT; ++j) out.M(i, nf + j) = pb.t(l)[j];
     out.e0[i] = xrow[static_cast<size_t>(pb.norm())];
   }
   return out;
@@ -414,8 +478,8 @@ Eigen::VectorXd residual_variance(const RecordProblem& pb, const Point& pt, int 
   const Eigen::Index n = static_cast<Eigen::Index>(lines.size());
   Eigen::VectorXd e2(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const int l = lines[static_cast<size_t>(i)];
-    e2[i] = std::norm(pb.data().Y[l] - pt.Yh[l]);
+    const int l = pb.index(lines[static_cast<size_t>(i)]);
+    e2[i] = std::norm(pb.Y()[l] - pt.Yh[l]);
   }
   const double debias = 2.0 * static_cast<double>(n) / (2.0 * static_cast<double>(n) - pb.n_par());
   Eigen::VectorXd var(n);
@@ -430,15 +494,16 @@ Eigen::VectorXd residual_variance(const RecordProblem& pb, const Point& pt, int 
 
 }  // namespace
 
-RecordRegression record_regression(const Parametrisation& p, const RecordData& d, bool transient) {
-  const RecordProblem pb(p, d, transient);
+RecordRegression record_regression(const Parametrisation& p, const RecordData& d, bool transient,
+                                   int transient_degree) {
+  const RecordProblem pb(p, d, transient, transient_degree);
   pb.check_lines();
   return regression(p, pb);
 }
 
 Eigen::VectorXcd record_prediction(const Parametrisation& p, const RecordData& d, const Eigen::VectorXd& eta_free,
-                                   const Eigen::VectorXd& c) {
-  const RecordProblem pb(p, d, c.size() > 0);
+                                   const Eigen::VectorXd& c, int transient_degree) {
+  const RecordProblem pb(p, d, c.size() > 0, transient_degree);
   if (eta_free.size() != pb.n_free()) {
     throw std::invalid_argument("eta_free must hold the " + str(pb.n_free()) + " free parameters, got " +
                                 str(eta_free.size()));
@@ -449,12 +514,11 @@ Eigen::VectorXcd record_prediction(const Parametrisation& p, const RecordData& d
   Eigen::VectorXd x(pb.n_par());
   x << eta_free, c;
   const Eigen::VectorXcd theta = pb.theta_of(x);
-  const Fds fds(pb.record_model(theta), 0, Solver::KLU);
-  return fds.solve_A(pb.forcing(theta, x));
+  return pb.fds(theta)->solve_A(pb.forcing(theta, x));
 }
 
 RecordFit fit_record(const Parametrisation& p, const RecordData& d, const RecordOptions& opt) {
-  const RecordProblem pb(p, d, opt.transient);
+  const RecordProblem pb(p, d, opt.transient, opt.transient_degree);
   pb.check_lines();
   const Eigen::Index n = static_cast<Eigen::Index>(d.lines.size());
   check_options(opt, n);
@@ -513,7 +577,7 @@ RecordFit fit_record(const Parametrisation& p, const RecordData& d, const Record
   for (int j = 0; j < pb.n_transient(); ++j) fit.transient_std[j] = std::sqrt(std::max(cov(nf + j, nf + j), 0.0));
   fit.noise_var = var;
   fit.Y_fit.resize(n);
-  for (Eigen::Index i = 0; i < n; ++i) fit.Y_fit[i] = lm.pt.Yh[d.lines[static_cast<size_t>(i)]];
+  for (Eigen::Index i = 0; i < n; ++i) fit.Y_fit[i] = lm.pt.Yh[pb.index(d.lines[static_cast<size_t>(i)])];
   fit.cost = lm.pt.cost;
   fit.dof = static_cast<int>(2 * n - np);
   fit.converged = lm.converged;

@@ -490,7 +490,7 @@ class RecordFit:
     @property
     def transient(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
-        c_1..c_n of T(z) = sum c_j z^j
+        c_1..c_n of T(z) = sum c_j z^j; continuous time c_0..c_d of sum c_j (j w ts)^j
         """
     @property
     def transient_std(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
@@ -575,14 +575,15 @@ def excited_lines(data: FrequencyData, ratio: typing.SupportsFloat | typing.Supp
     ...
 def expected_fraction_above_0db(n_rows: typing.SupportsInt | typing.SupportsIndex, n_free: typing.SupportsInt | typing.SupportsIndex, periods: typing.SupportsInt | typing.SupportsIndex) -> tuple[float, tuple[float, float]]:
     ...
-def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True, noise_var: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] | None = None, noise_width: typing.SupportsInt | typing.SupportsIndex = 10, reweightings: typing.SupportsInt | typing.SupportsIndex = 2, max_iterations: typing.SupportsInt | typing.SupportsIndex = 100, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-12) -> RecordFit:
+def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True, noise_var: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] | None = None, noise_width: typing.SupportsInt | typing.SupportsIndex = 10, reweightings: typing.SupportsInt | typing.SupportsIndex = 2, max_iterations: typing.SupportsInt | typing.SupportsIndex = 100, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-12, ts: typing.SupportsFloat | typing.SupportsIndex = 0.0, transient_degree: typing.SupportsInt | typing.SupportsIndex = -1) -> RecordFit:
     """
-    A discrete-time LPTV model and the transient term fitted to one record (METHOD.md section 17).
+    An LPTV model and the transient term fitted to one record (METHOD.md section 17).
     
     Parameters
     ----------
     par : Parametrisation
-        The structure (discrete time).
+        The structure: discrete time (its ts the record's sample time), or continuous time (ts = 0)
+        with the record's sample time in ``ts``.
     U, Y : ndarray, shape (N,), complex
         The record's DFT on all N = periods N0 lines: X_l = fft(x)[l] / N.
     periods : int
@@ -590,7 +591,8 @@ def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike,
     lines : list of int
         The lines fitted, ascending, within 1..(N-1)/2.
     transient : bool
-        Fit T(z) = sum_{j=1}^{n} c_j z^j, n = max(na, nb).
+        Fit T(z) = sum_{j=1}^{n} c_j z^j, n = max(na, nb); continuous time
+        T = sum_{j=0}^{d} c_j (j w_l ts)^j.
     noise_var : ndarray, optional
         E|V_l|^2 per fitted line; None: from the fit's residual, averaged over 2 noise_width + 1
         lines and debiased for the parameters, then the fit repeated ``reweightings`` times.
@@ -599,6 +601,10 @@ def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike,
         Levenberg-Marquardt iterations per fit.
     tol : float
         Relative tolerance of the cost's decrease, the step and the gradient's cosine.
+    ts : float
+        Continuous time: the record's sample time (> 0); discrete time: 0 or the structure's ts.
+    transient_degree : int
+        Continuous time: d (>= n - 1), -1 for n + 1; discrete time: -1 only.
     
     Returns
     -------
@@ -638,11 +644,11 @@ def multisine_spectrum(lines: collections.abc.Sequence[typing.SupportsInt | typi
     ...
 def real_column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
-def record_prediction(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, eta_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], c: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+def record_prediction(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, eta_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], c: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], ts: typing.SupportsFloat | typing.SupportsIndex = 0.0, transient_degree: typing.SupportsInt | typing.SupportsIndex = -1) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     """
-    Y_hat = A^-1 (B U - T(c)) on all N lines of the record's grid (eta_free: the free parameters).
+    Y_hat = A^-1 (B U - T(c)) on all N lines of the record's grid (continuous time: the lines -M..M, M = (N - 1) // 2, at index l + M; eta_free: the free parameters).
     """
-def record_regression(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]]:
+def record_regression(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True, ts: typing.SupportsFloat | typing.SupportsIndex = 0.0, transient_degree: typing.SupportsInt | typing.SupportsIndex = -1) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]]:
     """
     The equation error on the lines, E = M x + e0 for x = [free eta, c]: (M, e0).
     """

@@ -406,3 +406,55 @@ def transient_record(model: Model, periods: int = 4, noise_std: float = 0.01, se
         rhs = B[t] @ u[t:t + nb + 1] - A[t, :na] @ y[t:t + na]
         y[t + na] = rhs / A[t, na]
     return u[:N], y[:N] + noise_std * rng.standard_normal(N)
+
+
+def continuous_record(model: Model, periods: int = 2, samples_per_period: int = 1312, band: float = 4.0,
+                      noise_std: float = 0.01, seed=None, state_std: float = 3.0, input_std: float = 1.0,
+                      sinusoids: int = 200, rtol: float = 1e-12):
+    """One sampled record of a continuous-time LPTV model from a random state, band-limited input.
+
+    The input is a sum of ``sinusoids`` sinusoids of equal amplitude, random frequencies uniform
+    in (0.02 ``band``, ``band``) rad/s and random phases (rms ``input_std``): not periodic in the
+    record, band-limited, so its samples describe it whenever the Nyquist frequency pi / ts
+    exceeds ``band`` (a zero-order hold would not: the continuous input between its samples
+    is not the one they describe), and its derivatives are exact. The state (y, y', ...) at
+    t = 0 is Gaussian of ``state_std``; the output is integrated by SUNDIALS CVODE
+    (:func:`lptv.timedomain.free_response`, relative tolerance ``rtol``) at the times
+    k T0 / ``samples_per_period``, k = 0 .. ``periods`` ``samples_per_period`` - 1, and white
+    Gaussian noise of ``noise_std`` is added. Returns (u, y, ts), the data
+    :func:`lptv.identify_record` takes with ``continuous=True``. The default 1312 samples per
+    period put the third-order example's band (4 rad/s plus its sidebands) at a quarter of the
+    Nyquist frequency (METHOD.md section 17).
+
+    Examples
+    --------
+    >>> from lptv.examples import third_order_model, continuous_record
+    >>> u, y, ts = continuous_record(third_order_model(), periods=2, seed=0)
+    >>> u.shape, round(ts, 4)
+    ((2624,), 0.0958)
+    """
+    from . import timedomain
+
+    if not isinstance(model, Model) or model.discrete:
+        raise ValueError("model must be a continuous-time lptv.Model")
+    periods = as_int(periods, "periods", minimum=1, maximum=10**6)
+    samples_per_period = as_int(samples_per_period, "samples_per_period", minimum=2, maximum=10**8)
+    sinusoids = as_int(sinusoids, "sinusoids", minimum=1, maximum=10**5)
+    ts = model.period / samples_per_period
+    if not (np.isfinite(band) and 0 < band < np.pi / ts):
+        raise ValueError(f"band must lie in (0, pi / ts) = (0, {np.pi / ts:.6g}) rad/s, got {band!r}")
+    rng = np.random.default_rng(seed)
+    w = rng.uniform(0.02 * band, band, sinusoids)
+    phi = rng.uniform(0, 2 * np.pi, sinusoids)
+    amp = input_std * np.sqrt(2.0 / sinusoids)
+    orders = np.arange(model.nb + 1)
+
+    def derivatives(t):
+        c = amp * np.exp(1j * (w * t + phi))
+        return ((1j * w)[None, :] ** orders[:, None] * c[None, :]).real.sum(axis=1)
+
+    x0 = state_std * rng.standard_normal(model.na)
+    t = np.arange(periods * samples_per_period) * ts
+    y = timedomain.free_response(model, derivatives, t, x0=x0, rtol=rtol)
+    u = (amp * np.cos(np.outer(t, w) + phi)).sum(axis=1)
+    return u, y + noise_std * rng.standard_normal(t.size), ts

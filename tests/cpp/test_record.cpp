@@ -281,5 +281,17 @@ TEST_CASE("record: bad input is named", "[record]") {
   fails(good, opt, "max_iterations");
   lptv::Structure ct = discrete_structure(m);
   ct.ts = 0.0;
-  REQUIRE_THROWS_WITH(lptv::fit_record(lptv::Parametrisation(ct), good), Catch::Contains("discrete time only"));
+  // continuous time needs the record's sample time; discrete time takes none other than its own
+  REQUIRE_THROWS_WITH(lptv::fit_record(lptv::Parametrisation(ct), good),
+                      Catch::Contains("ts: a continuous-time record needs its sample time"));
+  d = good;
+  d.ts = 2.0;
+  fails(d, opt, "ts: the record's sample time");
+  opt.transient_degree = 4;
+  fails(good, opt, "transient_degree: discrete time takes only -1");
+  opt = lptv::RecordOptions();
+  lptv::RecordData dc = good;
+  dc.ts = 1.0;
+  opt.transient_degree = 0;  // below n - 1 = 1
+  REQUIRE_THROWS_WITH(lptv::fit_record(lptv::Parametrisation(ct), dc, opt), Catch::Contains("transient_degree must lie in"));
 }

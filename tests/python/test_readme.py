@@ -94,7 +94,15 @@ def test_readme_excitation_design_example_runs(tmp_path, monkeypatch):
 
 def test_readme_single_record_example_runs(tmp_path, monkeypatch):
     """One record: the fit with the transient is near its noise level, the one without is not."""
-    ns = run_block("lptv.identify_record(", tmp_path, monkeypatch)
+    ns = run_block("transient_record(", tmp_path, monkeypatch)
     res, steady = ns["res"], ns["steady"]
     assert res.periods == 4 and res.converged and 0.8 < res.cost_ratio < 1.2
     assert steady.cost_ratio > 5
+
+
+def test_readme_continuous_record_example_runs(tmp_path, monkeypatch):
+    """One continuous-time record (CVODE): a continuous-time model near its noise level."""
+    ns = run_block("continuous=True", tmp_path, monkeypatch)
+    res = ns["res"]
+    assert res.periods == 2 and res.converged and 0.8 < res.cost_ratio < 1.2
+    assert res.model.ts is None and res.transient.size == 5

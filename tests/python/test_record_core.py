@@ -173,5 +173,12 @@ def test_bad_arguments_of_the_core_are_named():
         _core.fit_record(par, U, Y, 2, lines[::-1])
     with pytest.raises(ValueError, match="noise_var must hold"):
         _core.fit_record(par, U, Y, 2, lines, noise_var=np.ones(3))
-    with pytest.raises(ValueError, match="discrete time only"):
-        _core.fit_record(_core.Parametrisation(2, 1, [2, 1, 0], [2, 0], [], m.w0, 0.0), U, Y, 2, lines)
+    ct = _core.Parametrisation(2, 1, [2, 1, 0], [2, 0], [], m.w0, 0.0)
+    with pytest.raises(ValueError, match="ts: a continuous-time record needs its sample time"):
+        _core.fit_record(ct, U, Y, 2, lines)
+    with pytest.raises(ValueError, match="ts: the record's sample time"):
+        _core.fit_record(par, U, Y, 2, lines, ts=2.0)
+    with pytest.raises(ValueError, match="transient_degree: discrete time takes only -1"):
+        _core.fit_record(par, U, Y, 2, lines, transient_degree=3)
+    with pytest.raises(ValueError, match="transient_degree must lie in"):
+        _core.fit_record(ct, U, Y, 2, lines, ts=1.0, transient_degree=0)

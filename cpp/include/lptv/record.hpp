@@ -1,4 +1,4 @@
-// One record with its transient (METHOD.md section 17): a discrete-time LPTV model fitted to a
+// One record with its transient (METHOD.md section 17): an LPTV model fitted to a
 // single record of L whole parameter periods, started from an unknown state under an arbitrary
 // input. On the record's DFT grid (N = L N0 lines, spacing w0 / L) harmonic k of a coefficient
 // shifts a spectrum by k L lines, and the record's transient is T(z_l) = sum_{j=1}^{n} c_j z_l^j,
@@ -6,6 +6,11 @@
 // squares of E_l(eta) + T(z_l) = 0), the output-error Levenberg-Marquardt on
 // Y_hat = A^-1 (B U - T) with the exact Jacobian, the residual noise-level reweighting and the
 // covariance (the inverse Fisher information of the output error).
+// Continuous time (the structure's ts = 0, RecordData::ts the record's sample time): the grid is
+// the signed lines -M..M, M = (N - 1) / 2, of the record's DFT (lines beyond dropped, as the
+// FDS does), z_l^n is (j w_l)^n, and the transient is T = sum_{j=0}^{d} c_j (j w_l ts)^j with
+// d = n + 1 by default: the Fourier coefficients' term of degree n - 1, the samples' offset of
+// the record's jump (degree n) and its first aliasing term (degree n + 1), METHOD.md section 17.
 #pragma once
 #include <Eigen/Dense>
 #include <vector>
@@ -20,6 +25,8 @@ struct RecordData {
   Eigen::VectorXcd U, Y;
   int periods = 1;         // L: whole parameter periods in the record (N = L N0)
   std::vector<int> lines;  // the lines fitted: ascending, distinct, within 1..(N-1)/2
+  double ts = 0;           // continuous time: the record's sample time (> 0); discrete time: 0
+                           // (the structure's ts is the sample time) or that same ts
 };
 
 // Where the output noise variance E|V_l|^2 comes from.
@@ -30,6 +37,9 @@ enum class RecordNoise {
 
 struct RecordOptions {
   bool transient = true;               // fit T (false: the steady-state model alone)
+  // Continuous time: the degree d of T (c_0..c_d), -1 for n + 1; at least n - 1. Discrete time:
+  // -1 only (the term z^1..z^n is exact there).
+  int transient_degree = -1;
   RecordNoise noise = RecordNoise::Residual;
   Eigen::VectorXd noise_var;           // Given: one positive variance per fitted line
   int noise_width = 10;                // Residual: half width of the average (>= 1)
@@ -47,7 +57,7 @@ struct RecordFit {
   // Covariance of eta (n_xi x n_xi; zero row and column at norm_index): the inverse of J^T J,
   // J the whitened Jacobian of the output error at the estimate.
   Eigen::MatrixXd covariance;
-  Eigen::VectorXd transient;           // c_1..c_n (empty without the transient term)
+  Eigen::VectorXd transient;           // c_1..c_n, or c_0..c_d in continuous time (empty without T)
   Eigen::VectorXd transient_std;
   // The start, [free eta, c], from the weighted equation error (the first fit's weights).
   Eigen::VectorXd start;
@@ -62,8 +72,8 @@ struct RecordFit {
   int fits = 0;                        // output-error fits run (1 + reweightings with Residual)
 };
 
-// The whole route. Throws std::invalid_argument naming the argument when the structure is not
-// discrete time, w0 and ts do not give a whole number N0 of samples per period, U and Y differ
+// The whole route. Throws std::invalid_argument naming the argument when the sample time is
+// missing (continuous time without RecordData::ts) or differs from the structure's, w0 and ts do not give a whole number N0 of samples per period, U and Y differ
 // in length or are not N = periods N0 lines of finite values, the lines are out of range,
 // unsorted or too few for the parameters, the options are out of range or the given variances
 // not positive and finite; NumericalError when the start or the estimate gives a singular A
@@ -78,9 +88,10 @@ struct RecordRegression {
   Eigen::MatrixXcd M;
   Eigen::VectorXcd e0;
 };
-RecordRegression record_regression(const Parametrisation& p, const RecordData& d, bool transient);
-// Y_hat = A^-1 (B U - T(c)) on all N lines, theta = Text xi (xi[norm_index] = 1), c = c_1..c_n.
+RecordRegression record_regression(const Parametrisation& p, const RecordData& d, bool transient,
+                                   int transient_degree = -1);
+// Y_hat = A^-1 (B U - T(c)) on all N lines (continuous time: the 2 M + 1 lines -M..M), theta = Text xi (xi[norm_index] = 1), c = c_1..c_n.
 Eigen::VectorXcd record_prediction(const Parametrisation& p, const RecordData& d, const Eigen::VectorXd& eta_free,
-                                   const Eigen::VectorXd& c);
+                                   const Eigen::VectorXd& c, int transient_degree = -1);
 
 }  // namespace lptv

@@ -8,6 +8,8 @@ modulo L (harmonic k moves a line by k L, so the classes do not couple: L system
 each a band that wraps around its corners, factorised by SuperLU (``scipy.sparse.linalg.splu``),
 where the core factorises the whole grid at once with KLU). The fit is SciPy's
 MINPACK Levenberg-Marquardt (``least_squares(method="lm")``) where the core has its own; the
+continuous-time grid (the signed lines -M..M, ``_CtGrid``) is one sparse matrix factorised by
+SuperLU, where the core runs its continuous-time FDS with KLU; the
 start is ``numpy.linalg.lstsq``. Nothing here calls ``lptv._core``; the local polynomial method
 (``noise="lpm"``, NumPy only, not in the core) is ``lptv.record.local_polynomial_noise``.
 """
@@ -68,6 +70,12 @@ class _Grid:
         """n columns: z^1..z^n (section 17)."""
         return np.stack([self.x**j for j in range(1, n + 1)], axis=1)
 
+    def spectrum(self, X):
+        return X
+
+    def index(self, lines):
+        return lines
+
     def factor(self, a):
         """LU factors of A (a: (na+1, 2K+1), harmonic k at column K + k) per residue class r of
         the lines modulo L: the lines r + m L, m = 0..N0-1, couple only among themselves, line
@@ -102,6 +110,68 @@ class _Grid:
         return out
 
 
+class _CtGrid:
+    """A continuous-time record's grid: the signed lines -M..M, M = (N - 1) // 2, at index l + M,
+    x_l = j l w0 / L; spectra beyond the grid are taken as zero (as the FDS does)."""
+
+    def __init__(self, N, L, w0):
+        self.N, self.L = N, L
+        self.M = (N - 1) // 2
+        self.line = np.arange(-self.M, self.M + 1)
+        self.G = self.line.size
+        self.x = 1j * self.line * (w0 / L)
+
+    def spectrum(self, X):
+        """The DFT (index l mod N) on the grid."""
+        return X[self.line % self.N]
+
+    def index(self, lines):
+        return np.asarray(lines) + self.M
+
+    def _shift(self, v, s):
+        """out[g] = v[g - s], zero where g - s leaves the grid."""
+        out = np.zeros_like(v)
+        if s >= 0:
+            out[s:] = v[:self.G - s]
+        else:
+            out[:self.G + s] = v[-s:]
+        return out
+
+    def apply(self, coef, X):
+        K = (coef.shape[1] - 1) // 2
+        out = np.zeros(self.G, dtype=complex)
+        for p in range(coef.shape[0]):
+            xp = self.x**p * X
+            for k in range(-K, K + 1):
+                c = coef[p, K + k]
+                if c != 0:
+                    out += c * self._shift(xp, k * self.L)
+        return out
+
+    def transient_basis(self, n):
+        """n columns: (j w_l ts)^0..(j w_l ts)^(n-1), j w_l ts = j 2 pi l / N."""
+        v = 2j * np.pi * self.line / self.N
+        return np.stack([v**j for j in range(n)], axis=1)
+
+    def factor(self, a):
+        K = (a.shape[1] - 1) // 2
+        g = np.arange(self.G)
+        rows, cols, vals = [], [], []
+        for k in range(-K, K + 1):
+            src = g - k * self.L
+            ok = (src >= 0) & (src < self.G)
+            z = self.x[src[ok]]
+            rows.append(g[ok])
+            cols.append(src[ok])
+            vals.append(sum(a[n, K + k] * z**n for n in range(a.shape[0])))
+        A = scipy.sparse.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                                    shape=(self.G, self.G))
+        return scipy.sparse.linalg.splu(A)
+
+    def solve(self, lu, R):
+        return lu.solve(np.ascontiguousarray(np.asarray(R, dtype=complex)))
+
+
 def _residual_variance(e2, width, n_par):
     """|Y - Y_hat|^2 averaged over the fitted lines within +-width positions (fewer at the
     ends), debiased by 2 n / (2 n - p)."""
@@ -114,7 +184,8 @@ def _residual_variance(e2, width, n_par):
 
 
 def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True, noise="residual",
-                    noise_width=10, lpm_branches=None, lpm_degree=2, max_iterations=100) -> RecordFit:
+                    noise_width=10, lpm_branches=None, lpm_degree=2, max_iterations=100, continuous=False,
+                    transient_degree=None) -> RecordFit:
     """The arguments of :func:`lptv.identify_record` (``ka``, ``kb``: one count per coefficient),
     assumed valid (this route is for comparisons, not for users' data)."""
     u = np.asarray(u, dtype=float)
@@ -123,13 +194,19 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
     n0 = int(round(2 * np.pi / (w0 * ts)))
     L = N // n0
     ka_l, kb_l = [int(k) for k in ka], [int(k) for k in kb]
-    par = Parametrisation(na, nb, ka_l, kb_l, (), w0, ts)
-    lines = np.arange(1, N // 2) if lines is None else np.unique(np.asarray(lines))
-    grid = _Grid(N, L)
+    par = Parametrisation(na, nb, ka_l, kb_l, (), w0, 0.0 if continuous else ts)
+    if lines is None:
+        lines = np.arange(1, (N - 1) // 8 + 1) if continuous else np.arange(1, N // 2)
+    else:
+        lines = np.unique(np.asarray(lines))
+    grid = _CtGrid(N, L, w0) if continuous else _Grid(N, L)
     U = np.fft.fft(u) / N
     Y = np.fft.fft(y) / N
     kmax = max(ka_l + kb_l)
-    nT = max(na, nb) if transient else 0
+    if continuous:
+        nT = (max(na, nb) + 2 if transient_degree is None else transient_degree + 1) if transient else 0
+    else:
+        nT = max(na, nb) if transient else 0
     norm = par.norm_index
     free = [i for i in range(par.n_xi) if i != norm]
     n_eta = len(free)
@@ -145,6 +222,8 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
         noise_dof = 0
 
     Ka, Kb = max(ka_l), max(kb_l)
+    U, Y = grid.spectrum(U), grid.spectrum(Y)
+    fit_lines, lines = lines, grid.index(lines)    # positions on the grid
 
     def arrays(theta):
         a = np.zeros((na + 1, 2 * Ka + 1), dtype=complex)
@@ -159,7 +238,7 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
     Text = par.Text
     dirs = [arrays(Text[:, i]) for i in free]
     a_norm, b_norm = arrays(Text[:, norm])
-    V = grid.transient_basis(nT) if nT else np.zeros((N, 0))
+    V = grid.transient_basis(nT) if nT else np.zeros((Y.size, 0))
 
     def theta_of(eta):
         xi = np.zeros(par.n_xi)
@@ -170,7 +249,7 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
     # start: the equation error E = A Y - B U + T, linear in eta and c, by weighted least squares
     E0 = grid.apply(a_norm, Y) - grid.apply(b_norm, U)
     cols = [grid.apply(ad, Y) - grid.apply(bd, U) for ad, bd in dirs]
-    Mf = np.stack(cols, axis=1) if cols else np.zeros((N, 0))
+    Mf = np.stack(cols, axis=1) if cols else np.zeros((Y.size, 0))
     Mf = np.concatenate([Mf, V], axis=1)
     sc = 1.0 / np.sqrt(var)
     Mr = np.concatenate([(Mf[lines] * sc[:, None]).real, (Mf[lines] * sc[:, None]).imag])
@@ -224,6 +303,6 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
     cov_eta[np.ix_(free, free)] = cov[:n_eta, :n_eta]
     return RecordFit(
         eta=eta, theta=theta_of(x[:n_eta]), covariance=cov_eta, transient=x[n_eta:].copy(),
-        transient_std=std[n_eta:], start=x0, lines=lines, periods=L, noise_var=var, noise_dof=int(noise_dof),
+        transient_std=std[n_eta:], start=x0, lines=fit_lines, periods=L, noise_var=var, noise_dof=int(noise_dof),
         Y=Y[lines], Y_fit=Yh[lines], cost=float(np.sum(sol.fun**2)), dof=int(2 * lines.size - x.size),
         converged=bool(sol.success), iterations=int(sol.nfev))
