@@ -201,3 +201,12 @@ def test_moderated_noise_with_several_experiments():
     assert len(res.moderation) == 2 and all(isinstance(m, lptv.ModeratedNoise) for m in res.moderation)
     assert res.experiments[0].periods > 4 and res.experiments[1].periods > 6
     assert res.residue_tests is not None
+
+
+def test_docstring_examples_run():
+    import doctest
+
+    import lptv.moderation
+
+    result = doctest.testmod(lptv.moderation, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
