@@ -49,6 +49,10 @@ class ModeratedNoise:
     """Per line: the weight d / (d + d0) of its own sample (co)variances (1 where kept)."""
     neighbour: np.ndarray = None
     """Per line: may serve as a neighbour (lines 1 .. Lmax - 1 that kept no own variance)."""
+    source_varU: np.ndarray = None
+    """The input's own sample variances (of the mean) the moderation started from."""
+    source_varY: np.ndarray = None
+    """The output's own sample variances (of the mean)."""
 
     def error_covariance(self, lines) -> np.ndarray:
         """Covariance of the relative sampling errors of the moderated variances on ``lines``
@@ -159,7 +163,8 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
         dof[0] = dof[L] = P - 1.0
 
     def unchanged():
-        return ModeratedNoise(data=data, dof=dof, prior_dof=0.0, outliers=np.zeros(0, int), half_width=W)
+        return ModeratedNoise(data=data, dof=dof, prior_dof=0.0, outliers=np.zeros(0, int), half_width=W,
+                              source_varU=vu, source_varY=vy)
 
     if P < 2 or L < 3 * W + 2:
         return unchanged()
@@ -220,4 +225,5 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     neighbour[inner[keep]] = True
     moderated = FrequencyData(data.U, data.Y, mu, my, mc, w0=data.w0, ts=data.ts, periods=P)
     return ModeratedNoise(data=moderated, dof=dof, prior_dof=float(d0), outliers=inner[out],
-                          half_width=W, own_weight=own_weight, neighbour=neighbour)
+                          half_width=W, own_weight=own_weight, neighbour=neighbour, source_varU=vu,
+                          source_varY=vy)

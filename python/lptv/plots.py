@@ -255,6 +255,59 @@ def distortion(d, *, hz: bool = False, ax=None):
     return ax
 
 
+def moderated_noise(mod, *, hz: bool = False, ax=None):
+    """The noise variances of a period mean per line, each line's own sample variance against the
+    moderated one (a :class:`lptv.ModeratedNoise`): output and input, in dB, with the lines that
+    kept their own (above their neighbours beyond noise) marked.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.standard_normal((4, 256)); y = 2 * u + 0.1 * rng.standard_normal((4, 256))
+    >>> mod = lptv.moderated_noise(lptv.FrequencyData.from_periods(u, y, w0=1.0))
+    >>> ax = lptv.plots.moderated_noise(mod)
+    >>> ax.get_ylabel()
+    'noise variance of the mean (dB)'
+    """
+    from .moderation import ModeratedNoise
+    from ._validate import as_bool
+
+    if not isinstance(mod, ModeratedNoise):
+        raise ValueError(f"mod must be an lptv.ModeratedNoise (from lptv.moderated_noise), got {type(mod).__name__}")
+    hz = as_bool(hz, "hz")
+    ax = _axes(ax)
+    d = mod.data
+    L = d.max_line
+    lines = np.arange(1, L)
+    own_u, own_y = _own_variances(mod)
+    x, label = _freq_axis(lines, d.w0, hz)
+    for own, moderated, color, name in ((own_y, d.varY, "C0", "output"), (own_u, d.varU, "C1", "input")):
+        if not np.any(np.asarray(moderated)[lines] > 0):
+            continue
+        ax.plot(x, 10 * np.log10(np.maximum(own[lines], 1e-300)), ".", ms=3, color=color, alpha=0.5,
+                label=f"{name}: each line's own")
+        ax.plot(x, 10 * np.log10(np.maximum(np.asarray(moderated)[lines], 1e-300)), "-", lw=1.2, color=color,
+                label=f"{name}: moderated")
+    if mod.outliers.size:
+        xo, _ = _freq_axis(mod.outliers, d.w0, hz)
+        ax.plot(xo, 10 * np.log10(np.maximum(own_y[mod.outliers], 1e-300)), "o", mfc="none", color="C3",
+                label="kept their own (above their neighbours)")
+    ax.set_xlabel(label)
+    ax.set_ylabel("noise variance of the mean (dB)")
+    dof = float(np.median(mod.dof[lines]))
+    ax.set_title(f"P = {d.periods}: own {2 * (d.periods - 1)} dof per line, moderated about {dof:.0f} "
+                 f"(d0 = {mod.prior_dof:.3g})", fontsize="medium")
+    ax.legend(fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
+def _own_variances(mod):
+    """The lines' own sample variances the moderation started from (kept on the result)."""
+    return np.asarray(mod.source_varU), np.asarray(mod.source_varY)
+
+
 def residue_tests(res, *, ax=None):
     """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`) as bars: each
     test's statistic z (standard normal without a model error) with the level at which the

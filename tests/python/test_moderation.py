@@ -210,3 +210,23 @@ def test_docstring_examples_run():
 
     result = doctest.testmod(lptv.moderation, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_plot_shows_own_and_moderated_variances_and_the_kept_lines():
+    pytest.importorskip("matplotlib")
+    import lptv.plots
+
+    L = 300
+    vy = np.full(L + 1, 0.01)
+    vy[150] = 2.0
+    d = _data(np.full(L + 1, 0.01), vy, 4, 7)
+    mod = lptv.moderated_noise(d)
+    ax = lptv.plots.moderated_noise(mod, hz=True)
+    labels = [ln.get_label() for ln in ax.get_lines()]
+    assert labels[:2] == ["output: each line's own", "output: moderated"]
+    assert "kept their own (above their neighbours)" in labels
+    own = ax.get_lines()[0].get_ydata()
+    assert np.allclose(own, 10 * np.log10(d.varY[1:L]))
+    assert ax.get_xlabel() == "frequency (Hz)"
+    with pytest.raises(ValueError, match="mod must be an lptv.ModeratedNoise"):
+        lptv.plots.moderated_noise(d)
