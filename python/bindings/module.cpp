@@ -24,6 +24,7 @@ PYBIND11_MODULE(_core, m) {
   bind_estimators(m);
   bind_htf_estimate(m);
   bind_distortion(m);
+  bind_moderation(m);
   bind_record(m);
   bind_floquet(m);
 }

@@ -20,5 +20,6 @@ void bind_likelihood(py::module_& m);
 void bind_estimators(py::module_& m);
 void bind_htf_estimate(py::module_& m);
 void bind_distortion(py::module_& m);
+void bind_moderation(py::module_& m);
 void bind_record(py::module_& m);
 void bind_floquet(py::module_& m);

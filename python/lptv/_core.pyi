@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'Model', 'NumericalError', 'Parametrisation', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'time_signal', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -434,6 +434,44 @@ class DistortionLines:
     @property
     def total(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
+class ModeratedNoise:
+    """
+    Noise (co)variances moderated across neighbouring lines (lptv::moderated_noise).
+    """
+    def error_covariance(self, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Covariance of the relative sampling errors of the moderated variances on lines.
+        """
+    @property
+    def data(self) -> FrequencyData:
+        ...
+    @property
+    def dof(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def half_width(self) -> int:
+        ...
+    @property
+    def moderated(self) -> bool:
+        ...
+    @property
+    def neighbour(self) -> typing.Annotated[numpy.typing.NDArray[numpy.bool], "[m, 1]"]:
+        ...
+    @property
+    def outliers(self) -> list[int]:
+        ...
+    @property
+    def own_weight(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def prior_dof(self) -> float:
+        ...
+    @property
+    def source_varU(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def source_varY(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 class RecordFit:
     """
     One record with its transient (lptv::fit_record).
@@ -546,6 +584,10 @@ def diagnose_data(data: FrequencyData, structure: Structure, rows: collections.a
     """
     The data diagnostics lptv::identify runs first: raises ValueError naming the argument and the cause for degenerate data (METHOD.md section 15).
     """
+def digamma(x: typing.SupportsFloat | typing.SupportsIndex) -> float:
+    """
+    The digamma function psi(x), x > 0.
+    """
 def distortion_lines(U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], varU: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], varY: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], covYU: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], excited: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], branches: typing.SupportsInt | typing.SupportsIndex) -> DistortionLines:
     """
     Noise, residual variance and BLA per output line from M random-phase realisations.
@@ -575,6 +617,10 @@ def excited_lines(data: FrequencyData, ratio: typing.SupportsFloat | typing.Supp
     ...
 def expected_fraction_above_0db(n_rows: typing.SupportsInt | typing.SupportsIndex, n_free: typing.SupportsInt | typing.SupportsIndex, periods: typing.SupportsInt | typing.SupportsIndex) -> tuple[float, tuple[float, float]]:
     ...
+def f_upper_quantile(p: typing.SupportsFloat | typing.SupportsIndex, d1: typing.SupportsFloat | typing.SupportsIndex, d2: typing.SupportsFloat | typing.SupportsIndex) -> float:
+    """
+    f with P(F(d1, d2) > f) = p.
+    """
 def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], transient: bool = True, noise_var: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"] | None = None, noise_width: typing.SupportsInt | typing.SupportsIndex = 10, reweightings: typing.SupportsInt | typing.SupportsIndex = 2, max_iterations: typing.SupportsInt | typing.SupportsIndex = 100, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-12, ts: typing.SupportsFloat | typing.SupportsIndex = 0.0, transient_degree: typing.SupportsInt | typing.SupportsIndex = -1) -> RecordFit:
     """
     An LPTV model and the transient term fitted to one record (METHOD.md section 17).
@@ -629,12 +675,31 @@ def identify_experiments(experiments: collections.abc.Sequence[FrequencyData], s
     rows: one list of rows per experiment (an empty list: that experiment's default rows), or
     empty for every experiment's default.
     """
+def incomplete_beta(a: typing.SupportsFloat | typing.SupportsIndex, b: typing.SupportsFloat | typing.SupportsIndex, x: typing.SupportsFloat | typing.SupportsIndex) -> float:
+    """
+    The regularized incomplete beta function I_x(a, b).
+    """
 def jacobian(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
 def lp_norm_log(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex, oversample: typing.SupportsInt | typing.SupportsIndex, p: typing.SupportsInt | typing.SupportsIndex) -> tuple[float, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
     ...
 def minimize_crest_factor(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex, oversample: typing.SupportsInt | typing.SupportsIndex = 0, max_p: typing.SupportsInt | typing.SupportsIndex = 1024, iterations_per_p: typing.SupportsInt | typing.SupportsIndex = 100) -> CrestResult:
     ...
+def moderated_noise(data: FrequencyData, half_width: typing.SupportsInt | typing.SupportsIndex) -> ModeratedNoise:
+    """
+    The noise (co)variances of data moderated across the lines within +-half_width.
+    
+    Parameters
+    ----------
+    data : FrequencyData
+        Spectra and noise statistics from P >= 2 periods (otherwise returned unchanged).
+    half_width : int
+        The neighbours of a line: the lines within +-half_width (>= 1).
+    
+    Returns
+    -------
+    ModeratedNoise
+    """
 def monodromy(model: Model, steps: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     """
     Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps
@@ -664,9 +729,23 @@ def simulate(model: Model, U: typing.Annotated[numpy.typing.ArrayLike, numpy.com
     ...
 def spectrum(x: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     ...
+def tetragamma(x: typing.SupportsFloat | typing.SupportsIndex) -> float:
+    """
+    The tetragamma function psi''(x), x > 0.
+    """
 def time_signal(X: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     ...
+def trigamma(x: typing.SupportsFloat | typing.SupportsIndex) -> float:
+    """
+    The trigamma function psi'(x), x > 0.
+    """
+def trigamma_inverse(x: typing.SupportsFloat | typing.SupportsIndex) -> float:
+    """
+    y > 0 with trigamma(y) = x.
+    """
 def weighted_r_factor(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
 FDS_MAX_CONDITION: float = 10000000000000.0
 FDS_WARN_CONDITION: float = 100000000.0
+MODERATION_MAX_PRIOR_DOF: float = 1000000.0
+MODERATION_OUTLIER_RATE: float = 0.001
