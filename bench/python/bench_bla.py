@@ -64,11 +64,11 @@ def one(args):
     rows = [rows] * M
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        d = lptv.distortion(u, y, w0=m.w0)
+        d = lptv.distortion(u, y, w0=m.w0, ts=m.ts)
         exps = d.experiments()
         bla = lptv.identify(exps, lines=rows, method="sml", **structure)
         jk = lptv.identify(exps, lines=rows, method="sml", covariance="realisations", **structure)
-        plain = lptv.identify([(u[i], y[i]) for i in range(M)], w0=m.w0, lines=rows, method="sml", **structure)
+        plain = lptv.identify([(u[i], y[i]) for i in range(M)], w0=m.w0, ts=m.ts, lines=rows, method="sml", **structure)
     return (bla.eta, bla.parameter_std, jk.parameter_std, plain.eta, plain.parameter_std, bool(d.detected),
             exps[0].periods, bla.eta_names)
 
