@@ -81,14 +81,25 @@ def main():
     ap.add_argument("--periods", type=int, default=4)
     ap.add_argument("--realisations", type=int, default=6, help="M (at least 4 for the jackknife)")
     ap.add_argument("--system", default="paper", choices=tuple(SYSTEMS))
+    ap.add_argument("--save", metavar="NPZ", help="keep every run's estimates and stds in this file")
     args = ap.parse_args()
     M = args.realisations
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as pool:
         out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system) for r in range(args.runs)],
                             chunksize=4))
+    n = len(out[0][0])
+    bad = [r for r, o in enumerate(out) if any(x is None or np.shape(x) != (n,) for x in o[:5])]
+    if bad:   # a fit without covariance: said, and left out of the statistics
+        print(f"# runs left out (a fit without a covariance or of another size): {bad}")
+        for r in bad[:5]:
+            print(f"#   run {r}: " + ", ".join("None" if x is None else str(np.shape(x)) for x in out[r][:5]))
+    out = [o for r, o in enumerate(out) if r not in set(bad)]
     R = len(out)
     eb, sb, sj, ep, sp, det, pe = (np.array([o[i] for o in out]) for i in range(7))
+    if args.save:
+        np.savez(args.save, eta=eb, std_analytic=sb, std_realisations=sj, eta_noise_only=ep, std_noise_only=sp,
+                 names=np.array(out[0][7]))
     free = sb[0] > 0
     names = np.array(out[0][7])[free]
     target = eb.mean(0)[free]
@@ -99,12 +110,14 @@ def main():
     print(f"{'parameter':>10} {'target':>10} {'se(target)':>10} {'analytic var/rep':>16} {'cover':>6} "
           f"{'realis. var/rep':>15} {'cover':>6} {'noise-only var/rep':>18} {'cover':>6}")
     rows = []
+    huge = np.zeros(names.size, int)
     for j, n in enumerate(names):
         col = np.flatnonzero(free)[j]
         err = np.abs(eb[:, col] - target[j])
         var_mc = eb[:, col].var(ddof=1)
         vr_b, cov_b = var_mc / np.mean(sb[:, col] ** 2), np.mean(err <= z95 * sb[:, col])
         vr_j, cov_j = var_mc / np.mean(sj[:, col] ** 2), np.mean(err <= z95 * sj[:, col])
+        huge[j] = np.sum(sj[:, col] > 10 * np.median(sj[:, col]))
         vr_p = ep[:, col].var(ddof=1) / np.mean(sp[:, col] ** 2)
         cov_p = np.mean(np.abs(ep[:, col] - ep[:, col].mean()) <= z95 * sp[:, col])
         rows.append((vr_b, cov_b, vr_j, cov_j, vr_p, cov_p))
@@ -120,6 +133,9 @@ def main():
     print(f"  realisations: {pct(3)}, var/rep median {np.median(a[:, 2]):.2f} (range {a[:, 2].min():.2f}-"
           f"{a[:, 2].max():.2f}; (M-3)/(M-1) = {(M - 3) / (M - 1):.2f} when right)")
     print(f"  noise only:   {pct(5)}, var/rep median {np.median(a[:, 4]):.2f}")
+    if huge.any():
+        print(f"  realisations: runs with a std above 10 times its median, per parameter: {huge.min()}-{huge.max()} "
+              "(a leave-one-out refit far from the others; var/rep is then dominated by them)")
 
 
 if __name__ == "__main__":
