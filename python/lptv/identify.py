@@ -528,6 +528,11 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         follows the randomness of the noise weights at small P where the factor does not
         (bench/RESULTS.md, "Coverage on three systems"); one data set only, about ``bootstrap``
         times the cost of the fit.
+        'realisations': several experiments that are independent random-phase realisations of
+        one excitation (:meth:`lptv.DistortionResult.experiments`, E >= 4 of them): the
+        leave-one-out jackknife over the experiments times (E-1)/(E-3) (:func:`realisation_covariance`,
+        METHOD.md section 16), which needs no model of how the nonlinear distortion is correlated
+        across lines; about E + 1 times the cost of the fit.
     bootstrap : int
         The number of refits for ``covariance='bootstrap'`` (at least 20).
     seed : int, optional
@@ -581,8 +586,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     """
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if not isinstance(covariance, str) or covariance not in ("analytic", "bootstrap"):
-        raise ValueError(f"covariance must be 'analytic' or 'bootstrap', got {covariance!r}")
+    if not isinstance(covariance, str) or covariance not in ("analytic", "bootstrap", "realisations"):
+        raise ValueError(f"covariance must be 'analytic', 'bootstrap' or 'realisations', got {covariance!r}")
     if not isinstance(noise, str) or noise not in ("sample", "moderated"):
         raise ValueError(f"noise must be 'sample' or 'moderated', got {noise!r}")
     if noise == "moderated" and covariance == "bootstrap":
@@ -643,6 +648,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         warnings.warn(unstable, UnstableModelWarning, stacklevel=2)
     if covariance == "bootstrap":
         cov = _bootstrap(r, model, structure, data, several, method, tol, max_iter, bootstrap, seed)
+    elif covariance == "realisations":
+        cov = _jackknife(r, structure, datas if several else None, rows if several else None, method, tol,
+                         max_iter)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -701,6 +709,55 @@ def _bootstrap(r, model, structure, data, several, method, tol, max_iter, B, see
     est.model = model
     cov = bootstrap_covariance(est, data, fit, B, seed)
     norm = [i for i, n in enumerate(eta_names) if np.allclose(cov[i], 0.0)]
+    for i in norm:
+        cov[i, :] = cov[:, i] = 0.0
+    return cov
+
+
+def realisation_covariance(estimates) -> np.ndarray:
+    """The covariance of a fit of E independent realisations from its E leave-one-out refits
+    (``estimates``, shape (E, n)): the jackknife (E-1)/E sum_e (eta_(e) - mean)(eta_(e) - mean)^T,
+    times (E-1)/(E-3), the variance of Student's t with E-1 degrees of freedom, so that
+    eta +- 1.96 std covers like the t interval (METHOD.md section 16).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> est = np.array([[1.0], [2.0], [3.0], [4.0], [5.0]])       # E = 5 refits
+    >>> float(realisation_covariance(est)[0, 0])                   # 4/5 * 10 * 4/2
+    16.0
+    """
+    est = np.asarray(estimates, dtype=float)
+    E = est.shape[0]
+    if E < 4:
+        raise ValueError(f"covariance='realisations' needs at least 4 experiments, got {E}")
+    d = est - est.mean(axis=0)
+    return (E - 1) / E * (d.T @ d) * (E - 1) / (E - 3)
+
+
+def _jackknife(r, structure, datas, rows, method, tol, max_iter):
+    """covariance='realisations': the jackknife over the experiments (:func:`realisation_covariance`)."""
+    if datas is None:
+        raise ValueError("covariance='realisations' takes a list of experiments (the realisations, e.g. "
+                         "DistortionResult.experiments()), not one data set")
+    if method not in ("wgtls", "sml"):
+        raise ValueError(f"covariance='realisations' is for method 'wgtls' or 'sml', got {method!r}")
+    E = len(datas)
+    if E < 4:
+        raise ValueError(f"covariance='realisations' needs at least 4 experiments (realisations), got {E}")
+    # each refit keeps the rows the full fit used for the experiments it keeps
+    used = np.asarray(r.experiment, dtype=int)
+    fit_rows = np.asarray(r.rows, dtype=int)
+    per = [[int(x) for x in fit_rows[used == e]] for e in range(E)]
+    est = []
+    for k in range(E):
+        keep = [e for e in range(E) if e != k]
+        rk = _core.identify_experiments([datas[e]._cpp for e in keep], structure, method=method, tol=float(tol),
+                                        max_iter=int(max_iter), rows=[per[e] for e in keep],
+                                        covariance=False)
+        est.append(np.asarray(rk.eta))
+    cov = realisation_covariance(est)
+    norm = [i for i in range(cov.shape[0]) if np.allclose(cov[i], 0.0)]
     for i in norm:
         cov[i, :] = cov[:, i] = 0.0
     return cov

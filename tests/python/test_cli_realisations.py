@@ -101,3 +101,26 @@ def test_identify_file_of_realisations_errors_name_the_realisation(tmp_path, cap
     rc = cli.main(["identify", str(src), *ARGS, "--covariance", "bootstrap", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 2 and "--covariance bootstrap takes one record" in err
+
+
+def test_identify_file_of_realisations_with_the_realisations_covariance(tmp_path, capsys):
+    """--covariance realisations: the library's jackknife over the realisations, in model.json,
+    summary.json and the report; refused for a record of periods of one realisation."""
+    src = tmp_path / "rig.npz"
+    u, y = _record(src, cubic=0.5, seed=4)
+    out = tmp_path / "out"
+    assert cli.main(["identify", str(src), *ARGS, "--covariance", "realisations", "--out", str(out)]) == 0
+    capsys.readouterr()
+    d = lptv.distortion(u, y, w0=MODEL.w0)
+    ref = lptv.identify(d.experiments(), na=1, nb=0, ka=1, kb=1, lines=[np.arange(2, 62)] * 4,
+                        covariance="realisations")
+    s = json.loads((out / "summary.json").read_text())
+    assert s["covariance"] == "realisations"
+    model = lptv.Model.load(out / "model.json")
+    assert np.allclose(model.covariance, ref.covariance, rtol=1e-9, atol=1e-15)
+    assert "jackknife over the realisations" in (out / "report.html").read_text()
+    one = tmp_path / "one.npz"
+    np.savez(one, u=u[0], y=y[0], w0=MODEL.w0)
+    rc = cli.main(["identify", str(one), *ARGS, "--covariance", "realisations", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--covariance realisations is for a record of M x P x N" in err

@@ -10,7 +10,9 @@ realisations of one amplitude spectrum with independent random phases tell them 
 2. identifies the best linear (time-periodic) approximation: the realisations are the
    experiments of one fit (:func:`lptv.identify` with a list), each output variance raised by
    the nonlinear level (:meth:`lptv.DistortionResult.experiments`), so that the parameter
-   covariance and the verdict include the nonlinear distortion;
+   covariance and the verdict include the nonlinear distortion (``--covariance realisations``:
+   the covariance from the realisations themselves, the jackknife of METHOD.md section 16, which
+   also holds where the distortion is correlated across lines);
    The rows of the fit are, unless ``--lines`` says otherwise, the excited band: lines K+1 to the
    highest excited line + K;
 3. writes ``model.json``, ``summary.json`` (with the distortion levels) and ``report.html``
@@ -51,9 +53,11 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     if getattr(args, "noise", "sample") != "sample":
         return _fail(src, "--noise moderated is for records of periods, not M x P x N realisations (their "
                           "variances are the noise's and the nonlinear distortion's, per realisation)")
-    if getattr(args, "covariance", "analytic") != "analytic":
+    covariance = getattr(args, "covariance", "analytic")
+    if covariance == "bootstrap":
         return _fail(src, "--covariance bootstrap takes one record of periods, not M x P x N realisations "
-                          "(their covariance includes the nonlinear distortion analytically)")
+                          "(their covariance includes the nonlinear distortion analytically, or from the "
+                          "realisations with --covariance realisations)")
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -71,7 +75,7 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                 lines = np.arange(K + 1, min(top, exps[0].max_line - K) + 1)
             per = lines if isinstance(lines, str) else [lines] * M
             res = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
-                           known=known, tol=args.tol, max_iter=args.max_iter)
+                           known=known, tol=args.tol, max_iter=args.max_iter, covariance=covariance)
     except (ValueError, NumericalError) as e:
         # the realisations are the fit's experiments: name them as such
         return _fail(src, re.sub(r"experiments?\[(\d+)\]|experiment (\d+)",
@@ -121,6 +125,7 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra):
         "iterations": res.iterations, "converged": res.converged, "cost": res.cost,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "parameters": parameter_table(res), "warnings": list(res.warnings) + extra,
+        "covariance": getattr(args, "covariance", "analytic"),
     }
 
 
@@ -152,7 +157,10 @@ def _report(src, meas, dist, res, summary) -> Report:
         + (", each output variance raised by the nonlinear level: the best linear time-periodic "
            "approximation, whose covariance includes the nonlinear distortion. Each realisation's raised "
            "variance is worth more periods than it has (the P of the summary below: the degrees of "
-           "freedom of noise and level together, METHOD.md section 16)." if dist.detected else "."))
+           "freedom of noise and level together, METHOD.md section 16)." if dist.detected else ".")
+        + (" The parameter covariance is the jackknife over the realisations (each left out in turn, "
+           "times (M-1)/(M-3)), which holds whatever the distortion's correlation across lines."
+           if summary.get("covariance") == "realisations" else ""))
     rep.paragraph("Verdict: " + res.verdict + ".")
     rep.preformatted(res.summary())
     rep.figure(plots.bode(res), "bode.png",

@@ -193,9 +193,11 @@ def add_parser(sub):
                    "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
                    "judges every row that reads a line with signal")
     p.add_argument("--method", default="wgtls", choices=METHODS, help="estimator (default wgtls)")
-    p.add_argument("--covariance", default="analytic", choices=("analytic", "bootstrap"),
-                   help="WGTLS/SML parameter covariance: the analytic sandwich (default) or a parametric "
-                   "bootstrap of --bootstrap refits (one record; better calibrated at few periods)")
+    p.add_argument("--covariance", default="analytic", choices=("analytic", "bootstrap", "realisations"),
+                   help="WGTLS/SML parameter covariance: the analytic sandwich (default), a parametric "
+                   "bootstrap of --bootstrap refits (one record; better calibrated at few periods), or, for "
+                   "a record of M >= 4 random-phase realisations, the jackknife over the realisations "
+                   "(intervals that include the nonlinear distortion's correlation across lines)")
     p.add_argument("--bootstrap", type=int, default=200, metavar="B",
                    help="refits for --covariance bootstrap (default 200)")
     p.add_argument("--noise", default="sample", choices=("sample", "moderated"),
@@ -241,8 +243,8 @@ def _fail(name, problem) -> int:
 def run(args) -> int:
     if args.covariance != "analytic" and (args.joint or len(args.files) > 1 or args.workers is not None
                                           or args.scheduler is not None):
-        print("lptv identify: error: --covariance bootstrap takes one record at a time (not several files, "
-              "--joint, --workers or --scheduler)", file=sys.stderr)
+        print(f"lptv identify: error: --covariance {args.covariance} takes one record at a time (not several "
+              "files, --joint, --workers or --scheduler)", file=sys.stderr)
         return 2
     if args.noise != "sample" and not args.joint and (len(args.files) > 1 or args.workers is not None
                                                       or args.scheduler is not None):
@@ -287,6 +289,9 @@ def run(args) -> int:
             from lptv.apps import blaid
 
             return blaid.run(args, src, meas, w0=w0, ts=ts, lines=lines, ka=ka, kb=kb, known=known)
+        if args.covariance == "realisations":
+            raise FileError("--covariance realisations is for a record of M x P x N random-phase realisations; "
+                            "this one holds periods of one realisation")
         record = check_record(meas.u, meas.y, warn=False)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
