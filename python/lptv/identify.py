@@ -376,6 +376,11 @@ class IdentificationResult:
         lines = [
             f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} lines",
         ]
+        if self.noise == "moderated":
+            worth = [("not moderated" if m is None else f"worth about {d.periods} periods per line (prior degrees of freedom d0 = {m.prior_dof:.3g}"
+                      + (f", {m.outliers.size} lines kept their own)" if m.outliers.size else ")"))
+                     for m, d in zip(self.moderation, self.experiments or (self.data,))]
+            lines.append("noise: moderated across neighbouring lines, " + "; ".join(worth))
         if self.experiments:
             lines.append(f"{self.n_experiments} experiments fitted together: " + "; ".join(
                 f"#{e}: {self._rows_of(e).size} lines, P = {d.periods}, lines 0..{d.max_line}"

@@ -230,3 +230,11 @@ def test_plot_shows_own_and_moderated_variances_and_the_kept_lines():
     assert ax.get_xlabel() == "frequency (Hz)"
     with pytest.raises(ValueError, match="mod must be an lptv.ModeratedNoise"):
         lptv.plots.moderated_noise(d)
+
+
+def test_summary_says_the_noise_was_moderated():
+    d = _system(seed=7)
+    res = _fit(d, method="sml", noise="moderated")
+    text = res.summary()
+    assert f"noise: moderated across neighbouring lines, worth about {res.data.periods} periods per line" in text
+    assert "noise: moderated" not in _fit(d, method="sml").summary()
