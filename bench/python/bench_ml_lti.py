@@ -72,7 +72,6 @@ import io
 import os
 import subprocess
 import sys
-import time
 import warnings
 
 import numpy as np
@@ -81,22 +80,14 @@ import lptv
 from lptv import _core
 from lptv.examples import noisy_periods
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_sml import fastest  # noqa: E402  (the routes take turns; each one's fastest round)
+
 N, W0, P = 2048, 0.01, 8
 LINES = list(range(1, 501))
 A_TRUE = np.polymul([1, 0.2, 1], [1, 0.6, 4])[::-1]        # a_0 .. a_4 (a_4 = 1)
 P_TRUE = np.r_[A_TRUE[:4], 1.0]                              # the free parameters a_0..a_3, b_0
 RELVARS = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12]
-
-
-def fastest(fns, rounds, inner):
-    best = {k: np.inf for k in fns}
-    for _ in range(rounds):
-        for k, f in fns.items():
-            t0 = time.perf_counter()
-            for _ in range(inner):
-                f()
-            best[k] = min(best[k], (time.perf_counter() - t0) / inner)
-    return best
 
 
 def load_fditools(path):

@@ -280,7 +280,7 @@ def moderated_noise(mod, *, hz: bool = False, ax=None):
     d = mod.data
     L = d.max_line
     lines = np.arange(1, L)
-    own_u, own_y = _own_variances(mod)
+    own_u, own_y = np.asarray(mod.source_varU), np.asarray(mod.source_varY)
     x, label = _freq_axis(lines, d.w0, hz)
     for own, moderated, color, name in ((own_y, d.varY, "C0", "output"), (own_u, d.varU, "C1", "input")):
         if not np.any(np.asarray(moderated)[lines] > 0):
@@ -301,11 +301,6 @@ def moderated_noise(mod, *, hz: bool = False, ax=None):
     ax.legend(fontsize="small")
     ax.grid(True, alpha=0.3)
     return ax
-
-
-def _own_variances(mod):
-    """The lines' own sample variances the moderation started from (kept on the result)."""
-    return np.asarray(mod.source_varU), np.asarray(mod.source_varY)
 
 
 def residue_tests(res, *, ax=None):

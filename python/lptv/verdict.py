@@ -161,10 +161,10 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         # The tests divide by the moderated (co)variances, with their degrees of freedom per
         # line; the fit weighed its rows by the sample ones (d_fit).
         nu_line, d_fit = None, d
-        fitted = res.moderation[e] if getattr(res, "moderation", ()) else None
+        fitted = res.moderation[e] if res.moderation else None
         if fitted is not None:        # the fit weighed by moderated variances: d holds them
             mo, nu_line = fitted, fitted.dof
-        elif MODERATE and P >= 2 and getattr(res, "noise", "sample") == "sample":
+        elif MODERATE and P >= 2 and res.noise == "sample":
             from .moderation import moderated_noise
             mo = moderated_noise(d)
             if mo.prior_dof > 0:
