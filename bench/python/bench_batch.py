@@ -159,8 +159,9 @@ def main():
                 print(f"   round {len(walls[name])}: {name} {wall:.3f} s (load {load()})", flush=True)
         print(f"{'executor':34s} {'wall s':>8s} {'fits/min':>9s} {'vs serial':>9s}  {'chunks (last call)':18s} rounds")
         for name, ex, kw, workers in executors:
+            task_min = lptv.batch.executors.TASK_MIN_DASK if ex.startswith("dask") else None
             plan = ("1 item at a time" if ex == "serial" else
-                    " ".join(map(str, chunk_sizes(R, workers, lptv.batch.executors._cost.get(COST_KEY)))))
+                    " ".join(map(str, chunk_sizes(R, workers, lptv.batch.executors._cost.get(COST_KEY), task_min))))
             ratio = best["serial"] / best[name]
             print(f"{name:34s} {best[name]:8.3f} {60 * R / best[name]:9.0f} {ratio:8.2f}x  {plan[:18]:18s} "
                   + " ".join(f"{w:.2f}" for w in walls[name]), flush=True)

@@ -118,9 +118,17 @@ def test_chunk_plan_covers_every_item_once_long_tasks_first():
                 assert sum(sizes) == n and min(sizes) >= 1
                 if cost:
                     assert all(a >= b for a, b in zip(sizes, sizes[1:]))     # long tasks first
+                    last = sizes[-min(w, n):]                                 # the last tasks: even
+                    assert max(last) - min(last) <= 1
+                    rounds = sizes[:len(sizes) - len(last)]
                     lo = max(1, int(np.ceil(ex.TASK_MIN / cost)))
-                    assert all(s >= lo for s in sizes[:-1])
+                    assert all(s >= lo for s in rounds)
+                    hi = max(lo, int(np.floor(ex.TASK_MAX / cost)))
+                    assert max(sizes) <= max(hi, -(-n // w))
     assert chunk_sizes(0, 2, 0.01) == []
+    assert chunk_sizes(64, 2, 0.0043) == [24, 24, 4, 4, 4, 4]     # rounds of equal tasks
+    assert chunk_sizes(256, 2, 0.0043) == [93, 93, 18, 18, 9, 9, 4, 4, 4, 4]
+    assert chunk_sizes(64, 2, 0.0043, task_min=0.04) == [24, 24, 8, 8]
 
 
 def test_second_call_is_planned_from_the_measured_cost_with_the_same_results(fresh_pool, monkeypatch):
@@ -147,12 +155,19 @@ def test_dask_plugin_registered_once_per_client_and_results_bit_identical(dask_c
     model, ms = small_lptv()
     serial = lptv.montecarlo(model, ms, executor="serial", **SMALL)
     with distributed.Client(dask_cluster, set_as_default=False) as client:
-        calls = []
+        calls, scatters = [], []
         real = client.register_plugin
         monkeypatch.setattr(client, "register_plugin", lambda *a, **k: calls.append(a) or real(*a, **k))
+        real_scatter = client.scatter
+        monkeypatch.setattr(client, "scatter", lambda *a, **k: scatters.append(a) or real_scatter(*a, **k))
         first = lptv.montecarlo(model, ms, executor=client, **SMALL)
         second = lptv.montecarlo(model, ms, executor=client, **SMALL)
         assert len(calls) <= 1 and client in lptv.batch.dask_plugin._registered
+        # the design went to the workers once: the second study (equal design) reused it
+        assert len(scatters) == 1
+        third = lptv.montecarlo(model, ms, executor=client, **dict(SMALL, snr_out_db=SMALL["snr_out_db"] + 1))
+        assert len(scatters) == 2      # another design: sent again
+        assert not np.array_equal(third.estimates["wgtls"], second.estimates["wgtls"])
         names = client.run_on_scheduler(lambda dask_scheduler: list(dask_scheduler.worker_plugins))
         assert lptv.batch.dask_plugin.NAME in names
         # the workers ran the warm-up: scipy.signal is there, and the trimming variable still is

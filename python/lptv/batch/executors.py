@@ -39,11 +39,14 @@ run. One thread per process is also what a process per core wants.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import hashlib
 import math
 import os
+import pickle
 import sys
 import time
 import traceback
+import weakref
 from dataclasses import dataclass
 from typing import Any, Callable, List, Optional, Sequence
 
@@ -55,10 +58,12 @@ EXTRA = "pip install 'lptv[batch]'"
 MAX_CHUNK = 32
 CHUNKS_PER_WORKER = 4
 # Once the cost of an item is known (measured by the workers on an earlier call of the same
-# function in this process), a task lasts TASK_MIN..TASK_MAX seconds: at least ~20 times the
-# per-task overhead of a process pool (1-1.5 ms), at most what a progress bar and a checkpoint
-# should wait for.
-TASK_MIN, TASK_MAX = 0.025, 0.4
+# function in this process), a task lasts TASK_MIN..TASK_MAX seconds: about ten times the
+# per-task overhead of a process pool (about 1 ms; TASK_MIN_DASK for Dask's 3-4 ms), at most
+# what a progress bar and a checkpoint should wait for. The first round of tasks holds
+# FIRST_SHARE of the items (bench/RESULTS.md, "Chunks in rounds").
+TASK_MIN, TASK_MIN_DASK, TASK_MAX = 0.01, 0.04, 0.4
+FIRST_SHARE = 0.75
 
 _cost = {}   # (module, qualified name) of a task function -> seconds per item, last measured
 
@@ -94,14 +99,29 @@ def _call(fn, item, shared):
         return Failure(_one_line(e), traceback.format_exc())
 
 
+_limited_at = [-1]   # len(sys.modules) when one_blas_thread last set the limits in this process
+
+
 def one_blas_thread():
     """Limit the BLAS libraries loaded in this process to one thread; returns the function that
-    restores the previous limits (a no-op without threadpoolctl)."""
+    restores the previous limits (a no-op without threadpoolctl).
+
+    threadpoolctl scans the loaded libraries on every call (0.7 ms; once per chunk, 3-4 % of a
+    short chunk's time), so a call made while the last limits hold (not restored) and no module
+    was imported since, hence no BLAS library loaded, returns at once."""
+    if len(sys.modules) == _limited_at[0]:
+        return lambda: None
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:
         return lambda: None
-    return threadpool_limits(limits=1, user_api="blas").restore_original_limits
+    restore = threadpool_limits(limits=1, user_api="blas").restore_original_limits
+    _limited_at[0] = len(sys.modules)
+
+    def restore_and_forget():
+        _limited_at[0] = -1
+        restore()
+    return restore_and_forget
 
 
 def run_chunk(items: Sequence, fn: Callable, shared: Any) -> list:
@@ -134,31 +154,39 @@ def default_chunk_size(n_items: int, workers: int) -> int:
     return max(1, min(MAX_CHUNK, math.ceil(n_items / (CHUNKS_PER_WORKER * max(1, workers)))))
 
 
-def chunk_sizes(n_items: int, workers: int, cost: Optional[float] = None) -> List[int]:
+def chunk_sizes(n_items: int, workers: int, cost: Optional[float] = None,
+                task_min: Optional[float] = None) -> List[int]:
     """The sizes of the tasks, in the order they are sent.
 
     Without a measured ``cost`` (seconds per item), :func:`default_chunk_size` for every task.
-    With one, the tasks shrink as the work left does (guided self-scheduling): each takes half
-    a worker's share of what is left, ``ceil(left / (2 workers))`` items, within
-    TASK_MIN..TASK_MAX seconds of work. The first tasks are long (little overhead) and the last
-    ones short, so that the workers finish together instead of one waiting for the other's last
-    chunk: for 64 items of 6 ms on 2 workers, 16 12 9 7 5 5 5 5 instead of 8 tasks of 8.
+    With one, the tasks come in rounds of ``workers`` equal tasks (factoring): the first round
+    takes FIRST_SHARE of the items, each later round half of what is left, each task at least
+    ``task_min`` seconds of work (default TASK_MIN; about ten times the executor's per-task
+    overhead) and at most TASK_MAX; the round that would go below that splits what is left
+    evenly over the workers. The workers start and end each round together, so they finish
+    together, with few tasks: for 64 items of 4.3 ms on 2 workers, 24 24 4 4 4 4.
 
-    >>> chunk_sizes(64, 2), chunk_sizes(64, 2, cost=0.006)
-    ([8, 8, 8, 8, 8, 8, 8, 8], [16, 12, 9, 7, 5, 5, 5, 5])
+    >>> chunk_sizes(64, 2), chunk_sizes(64, 2, cost=0.0043)
+    ([8, 8, 8, 8, 8, 8, 8, 8], [24, 24, 4, 4, 4, 4])
     """
     if n_items <= 0:
         return []
     if not cost or not math.isfinite(cost) or cost <= 0:
         size = default_chunk_size(n_items, workers)
         return [size] * (n_items // size) + ([n_items % size] if n_items % size else [])
-    lo = max(1, math.ceil(TASK_MIN / cost))
+    W = max(1, workers)
+    lo = max(1, math.ceil((TASK_MIN if task_min is None else task_min) / cost))
     hi = max(lo, math.floor(TASK_MAX / cost))
-    sizes, left = [], n_items
+    sizes, left, share = [], n_items, FIRST_SHARE
     while left > 0:
-        size = min(left, max(lo, min(hi, math.ceil(left / (2 * max(1, workers))))))
-        sizes.append(size)
-        left -= size
+        size = min(hi, math.ceil(share * left / W))
+        share = 0.5
+        if size < lo or left - size * W < W:   # the last round: what is left, evenly over the workers
+            k = max(min(W, left), math.ceil(left / hi))
+            sizes += [left // k + (1 if i < left % k else 0) for i in range(k)]
+            break
+        sizes += [size] * W
+        left -= size * W
     return sizes
 
 
@@ -166,13 +194,13 @@ def _cost_key(fn):
     return (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None))
 
 
-def _plan(todo, workers, chunk_size, fn):
+def _plan(todo, workers, chunk_size, fn, task_min=None):
     """The chunks of ``todo`` (lists of item indices): of ``chunk_size`` items if given, else
     of :func:`chunk_sizes` with the cost measured on the last call of ``fn``."""
     if chunk_size:
         return [[todo[k] for k in c] for c in _chunks(len(todo), chunk_size)]
     chunks, start = [], 0
-    for size in chunk_sizes(len(todo), workers, _cost.get(_cost_key(fn))):
+    for size in chunk_sizes(len(todo), workers, _cost.get(_cost_key(fn)), task_min):
         chunks.append(todo[start:start + size])
         start += size
     return chunks
@@ -442,6 +470,28 @@ def _run_futures(fn, items, todo, shared, executor, workers, chunk_size, bar, we
         pool.shutdown(wait=True)
 
 
+_shared_on = weakref.WeakKeyDictionary()   # Dask client -> (digest, future) of the last shared argument
+
+
+def _scattered(client, shared):
+    """``shared`` on every worker of ``client``'s cluster, as a future: one copy per worker
+    instead of one per task, scattered once and kept for the next call with equal contents (a
+    study repeated with the same design skips the round trip, 5-7 ms on a 2-core LocalCluster).
+    In a list, so that it gets a key of its own (a dict would be scattered under its own keys,
+    shared by every run)."""
+    try:
+        digest = hashlib.blake2b(pickle.dumps(shared, protocol=pickle.HIGHEST_PROTOCOL), digest_size=20).digest()
+    except Exception:  # noqa: BLE001 - not picklable by pickle (Dask's cloudpickle may manage): no reuse
+        digest = None
+    kept = _shared_on.get(client)
+    if digest is not None and kept is not None and kept[0] == digest and kept[1].status == "finished":
+        return kept[1]
+    [fut] = client.scatter([shared], broadcast=True, hash=False)
+    if digest is not None:
+        _shared_on[client] = (digest, fut)
+    return fut
+
+
 def _run_dask(fn, items, todo, shared, executor, chunk_size, bar, weight, finished, out):
     distributed = require("distributed", "a Dask executor")
     client = distributed.Client(executor, set_as_default=False) if isinstance(executor, str) else executor
@@ -449,13 +499,11 @@ def _run_dask(fn, items, todo, shared, executor, chunk_size, bar, weight, finish
         from .dask_plugin import register
 
         register(client)   # every worker imports lptv and scipy.signal once, before its first chunk
-        chunks = _plan(todo, _dask_threads(client), chunk_size, fn)
+        chunks = _plan(todo, _dask_threads(client), chunk_size, fn, TASK_MIN_DASK)
         if not chunks:
             return
         clock = _Clock(fn)
-        # one copy of the design per worker instead of one per task; in a list, so that it gets a
-        # key of its own (a dict would be scattered under its own keys, shared by every run)
-        [shared_f] = client.scatter([shared], broadcast=True, hash=False)
+        shared_f = _scattered(client, shared)
         # the chunks in the order planned (the long ones first): the scheduler runs the higher
         # priority first, and would otherwise order tasks of equal priority by their random keys
         futures = [client.submit(_timed_chunk, [items[i] for i in c], fn=fn, shared=shared_f, pure=False,
