@@ -78,6 +78,18 @@ def main(argv=None):
             pv = np.array([x[2] for r in sel for x in r[3] if x[0] == n])
             print(f"   {n[:46]:46s} mean {st.mean():6.2f} sd {st.std():5.2f}  p<0.05 {np.mean(pv < 0.05):.3f} "
                   f"p<0.01 {np.mean(pv < 0.01):.3f} p<0.001 {np.mean(pv < 0.001):.4f}")
+        why = {}
+        for r in sel:
+            for x in r[3]:
+                if x[3] <= lptv.verdict.ALPHA:
+                    key = x[0] + (" (too small)" if x[1] < 0 and "harmonic" not in x[0] else "")
+                    why.setdefault(key, []).append(f"{r[0][:5]}{r[1]}")
+        for n, where in sorted(why.items()):
+            print(f"   rejects: {n[:58]:58s} {len(where):3d}x  {' '.join(where)}")
+        kk = np.array([len(r[3]) for r in sel])
+        bonf = np.array([min(x[2] for x in r[3]) * k for r, k in zip(sel, kk)])
+        print(f"   families whose smallest p-value is below 1 % / k (Bonferroni; k = {kk.min()}-{kk.max()} tests): "
+              f"{100 * np.mean(bonf <= lptv.verdict.ALPHA):.2f} %")
         allp = np.array([x[2] for r in sel for x in r[3]])
         print(f"   pooled over the tests (n = {allp.size}): p<0.05 {np.mean(allp < 0.05):.4f} "
               f"p<0.01 {np.mean(allp < 0.01):.4f} p<0.001 {np.mean(allp < 0.001):.4f}")
