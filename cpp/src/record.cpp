@@ -266,6 +266,13 @@ struct TallSvd {
     return V * (inv_s(1).asDiagonal() * (U.transpose() * (Q.transpose() * b)));
   }
   Eigen::MatrixXd gram_inverse() const { return V * inv_s(2).asDiagonal() * V.transpose(); }
+  // The diagonal of the projection onto A's column space (each row's leverage): the squared
+  // row norms of Q U over the singular values above the cut.
+  Eigen::VectorXd leverage() const {
+    Eigen::Index r = 0;
+    while (r < s.size() && s[r] > cut) ++r;
+    return (Q * U.leftCols(r)).rowwise().squaredNorm();
+  }
 };
 
 // The output error at one point: A factorised, the prediction on all lines, the whitened
@@ -471,23 +478,27 @@ RecordRegression regression(const Parametrisation& p, const RecordProblem& pb) {
   return out;
 }
 
-// The residual's noise level (METHOD.md section 17): |Y - Y_hat|^2 averaged over the fitted
-// lines within +-width positions (fewer at the ends), times 2 n / (2 n - p).
-Eigen::VectorXd residual_variance(const RecordProblem& pb, const Point& pt, int width) {
+// The residual's noise level (METHOD.md section 17): each line's |Y - Y_hat|^2 over its share
+// 1 - h_l of the noise the fit leaves (h_l the mean leverage of its Re and Im rows in the
+// weighted Jacobian J at the fit; 1 - h_l at least kMinShare), averaged over the fitted lines
+// within +-width positions (fewer at the ends).
+constexpr double kMinShare = 0.05;
+Eigen::VectorXd residual_variance(const RecordProblem& pb, const Point& pt, const Eigen::MatrixXd& J, int width) {
   const auto& lines = pb.data().lines;
   const Eigen::Index n = static_cast<Eigen::Index>(lines.size());
+  const Eigen::VectorXd h = TallSvd(J).leverage();
   Eigen::VectorXd e2(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const int l = pb.index(lines[static_cast<size_t>(i)]);
-    e2[i] = std::norm(pb.Y()[l] - pt.Yh[l]);
+    const double share = std::max(1.0 - 0.5 * (h[i] + h[n + i]), kMinShare);
+    e2[i] = std::norm(pb.Y()[l] - pt.Yh[l]) / share;
   }
-  const double debias = 2.0 * static_cast<double>(n) / (2.0 * static_cast<double>(n) - pb.n_par());
   Eigen::VectorXd var(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Index lo = std::max<Eigen::Index>(0, i - width), hi = std::min<Eigen::Index>(n - 1, i + width);
     double s = 0.0;
     for (Eigen::Index j = lo; j <= hi; ++j) s += e2[j];
-    var[i] = std::max(s / static_cast<double>(hi - lo + 1) * debias, 1e-300);
+    var[i] = std::max(s / static_cast<double>(hi - lo + 1), 1e-300);
   }
   return var;
 }
@@ -557,7 +568,7 @@ RecordFit fit_record(const Parametrisation& p, const RecordData& d, const Record
   LmOutcome lm = run(OutputError(pb, var));
   if (opt.noise == RecordNoise::Residual) {
     for (int k = 0; k < opt.reweightings; ++k) {
-      var = residual_variance(pb, lm.pt, opt.noise_width);
+      var = residual_variance(pb, lm.pt, lm.J, opt.noise_width);
       x = lm.x;
       lm = run(OutputError(pb, var));
     }

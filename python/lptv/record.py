@@ -138,9 +138,9 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         transient; for comparison).
     noise : {"residual", "lpm"} or float or array
         The output noise variance E|V_l|^2 per line. ``"residual"`` (default): from the fit's own
-        residual, |Y_l - Y_fit,l|^2 averaged over the 2 ``noise_width`` + 1 lines around l and
-        scaled by 2 n / (2 n - p) for the p parameters fitted to the 2 n real residues, the fit
-        then repeated with those weights (twice); it needs the structure to be right.
+        residual, |Y_l - Y_fit,l|^2 over 1 - h_l (h_l the line's leverage in the fit: the share
+        of its noise the parameters absorb) averaged over the 2 ``noise_width`` + 1 lines around
+        l, the fit then repeated with those weights (twice); it needs the structure to be right.
         ``"lpm"``: the local polynomial method (:func:`local_polynomial_noise`), which needs no
         model but assumes the HTF's branches beyond ``lpm_branches`` negligible and each branch
         and the output transient locally polynomial over its window: on a strongly time-varying

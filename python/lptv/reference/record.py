@@ -172,14 +172,22 @@ class _CtGrid:
         return lu.solve(np.ascontiguousarray(np.asarray(R, dtype=complex)))
 
 
-def _residual_variance(e2, width, n_par):
-    """|Y - Y_hat|^2 averaged over the fitted lines within +-width positions (fewer at the
-    ends), debiased by 2 n / (2 n - p)."""
+MIN_SHARE = 0.05
+
+
+def _residual_variance(e2, width, J):
+    """Each line's |Y - Y_hat|^2 over its share 1 - h_l of the noise the fit leaves (h_l the mean
+    leverage of its Re and Im rows in the weighted Jacobian J, [Re rows; Im rows]; the share at
+    least MIN_SHARE), averaged over the fitted lines within +-width positions (fewer at the ends)."""
     n = e2.size
+    U, s, _ = np.linalg.svd(J, full_matrices=False)
+    cut = (s[0] if s.size else 0.0) * np.finfo(float).eps * max(J.shape)
+    h2 = np.sum(U[:, s > cut] ** 2, axis=1)
+    e2 = e2 / np.maximum(1.0 - 0.5 * (h2[:n] + h2[n:]), MIN_SHARE)
     cum = np.concatenate([[0.0], np.cumsum(e2)])
     i = np.arange(n)
     lo, hi = np.maximum(0, i - width), np.minimum(n, i + width + 1)
-    var = (cum[hi] - cum[lo]) / (hi - lo) * (2 * n / (2 * n - n_par))
+    var = (cum[hi] - cum[lo]) / (hi - lo)
     return np.maximum(var, 1e-300)
 
 
@@ -281,10 +289,10 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
 
     sol = fit(x0)
     if isinstance(noise, str) and noise == "residual":
-        # the residual's local mean square, debiased for the parameters, then the fit again
+        # the residual's local mean square, each line's over its share 1 - h_l, then the fit again
         for _ in range(2):
             *_, Yh = predict(sol.x)
-            var = _residual_variance(np.abs((Y - Yh)[lines]) ** 2, noise_width, x0.size)
+            var = _residual_variance(np.abs((Y - Yh)[lines]) ** 2, noise_width, sol.jac)
             w = 1.0 / np.sqrt(var / 2.0)
             sol = fit(sol.x)
         noise_dof = 2 * noise_width + 1
