@@ -37,6 +37,7 @@ from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros,
 from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
                         multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
 from .moderation import ModeratedNoise, moderated_noise
+from .disturbances import Disturbance, DisturbanceResult, disturbances
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 
 __version__ = "0.1.0"
@@ -50,4 +51,5 @@ __all__ = [
     "lti_table", "parameter_table", "compare", "freqresp_band",
     "CrestDesign", "ExcitationLines", "excitation_lines", "min_crest_multisine", "multisine_realisations",
     "schroeder_multisine", "RecordResult", "identify_record", "ModeratedNoise", "moderated_noise",
+    "Disturbance", "DisturbanceResult", "disturbances",
 ]

@@ -98,6 +98,9 @@ class IdentificationResult:
     moderation: Tuple[object, ...] = field(default_factory=tuple, repr=False, compare=False)
     """noise='moderated': per experiment, the :class:`lptv.ModeratedNoise` the fit used (None for
     an experiment whose variances could not be moderated); empty otherwise."""
+    disturbances: Tuple[object, ...] = field(default_factory=tuple, repr=False, compare=False)
+    """disturbances='remove': the :class:`lptv.Disturbance` sinusoids (off the period's grid)
+    found in the records and subtracted before the fit; empty otherwise or when none was found."""
 
     @property
     def n_experiments(self) -> int:
@@ -381,6 +384,9 @@ class IdentificationResult:
                       + (f", {m.outliers.size} lines kept their own)" if m.outliers.size else ")"))
                      for m, d in zip(self.moderation, self.experiments or (self.data,))]
             lines.append("noise: moderated across neighbouring lines, " + "; ".join(worth))
+        if self.disturbances:
+            lines.append("removed before the fit: " + "; ".join(
+                f"{d.signal}: a sinusoid at line {d.line:.3f} (amplitude {d.amplitude:.3g})" for d in self.disturbances))
         if self.experiments:
             lines.append(f"{self.n_experiments} experiments fitted together: " + "; ".join(
                 f"#{e}: {self._rows_of(e).size} lines, P = {d.periods}, lines 0..{d.max_line}"
@@ -484,7 +490,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
              kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
              lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
              max_iter: int = 50, covariance: str = "analytic", bootstrap: int = 200,
-             seed=None, noise: str = "sample") -> IdentificationResult:
+             seed=None, noise: str = "sample", disturbances: Optional[str] = None) -> IdentificationResult:
     """Estimate an LPTV model from noisy input/output periods.
 
     Parameters
@@ -553,6 +559,14 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         assumes a noise spectrum that is smooth over a few lines (lines far above their
         neighbours keep their own variance). Not with ``covariance='bootstrap'``. ``res.data``
         holds the moderated data the fit used.
+    disturbances : {None, 'remove'}
+        'remove': before the fit, find the sinusoids that are not periodic in the record (off
+        the period's grid, such as mains hum beside a multisine whose period is not a multiple
+        of the mains period) in the input and output periods and subtract them
+        (:func:`lptv.disturbances`, METHOD.md section 7); ``res.disturbances`` lists them.
+        Such a sinusoid inflates the noise variances of the lines around it and makes the
+        verdict find residues "too small". Needs the periods (``(u, y)`` arrays or pairs), not
+        :class:`FrequencyData`. Default None: the records as given.
 
     Raises
     ------
@@ -598,11 +612,16 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     if noise == "moderated" and covariance == "bootstrap":
         raise ValueError("noise='moderated' is not for covariance='bootstrap': the bootstrap draws P periods "
                          "from each line's own sample variances; use covariance='analytic' with moderated noise")
+    if disturbances is not None and (not isinstance(disturbances, str) or disturbances != "remove"):
+        raise ValueError(f"disturbances must be None or 'remove', got {disturbances!r}")
     bootstrap = as_int(bootstrap, "bootstrap", minimum=20)
     na, nb = as_int(na, "na"), as_int(nb, "nb")
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter")
     several = y is None and isinstance(u, (list, tuple))
+    found = ()
+    if disturbances == "remove":
+        u, y, found = _without_disturbances(u, y, several)
     if several:
         datas = experiments_of(u, w0, ts)
         data = datas[0]
@@ -669,7 +688,36 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
         unstable=unstable, stability_undecided=undecided, structure=structure, noise=noise,
-        moderation=moderation)
+        moderation=moderation, disturbances=found)
+
+
+def _without_disturbances(u, y, several):
+    """disturbances='remove': the periods without the sinusoids :func:`lptv.disturbances` finds
+    (each (u, y) pair of several experiments alike), and those sinusoids."""
+    from .disturbances import disturbances as find
+
+    def clean(uu, yy, where):
+        if isinstance(uu, FrequencyData) or yy is None:
+            raise ValueError(f"disturbances='remove' needs the periods (u, y), not FrequencyData{where}: "
+                             "the spectra no longer hold what differs between the periods")
+        try:
+            out = find(uu, yy)
+        except ValueError as e:
+            raise ValueError(f"disturbances='remove'{where}: {e}") from None
+        return out.u, out.y, out.found
+
+    if not several:
+        u2, y2, found = clean(u, y, "")
+        return u2, y2, found
+    items, found = [], []
+    for i, item in enumerate(u):
+        if isinstance(item, (list, tuple)) and len(item) == 2:
+            uu, yy, f = clean(item[0], item[1], f" (experiments[{i}])")
+            items.append((uu, yy))
+            found.extend(f)
+        else:
+            clean(item, None, f" (experiments[{i}])")
+    return items, None, tuple(found)
 
 
 def _moderated(d):

@@ -95,9 +95,13 @@ class ResidueTests:
                            f"{t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} < {self.alpha:g})")
                 continue
             side = "too large" if t.statistic > 0 else "too small"
+            why = ("" if t.statistic > 0 else
+                   ": an over-fitted structure, or noise variances inflated by a disturbance that is not "
+                   "periodic in the record (a sinusoid off the period's grid, such as mains hum: "
+                   "lptv.disturbances(u, y) finds it, identify(..., disturbances='remove') removes it)")
             out.append(f"the normalised residues on the {t.rows.size} {t.name} are {side} "
                        f"(z = {t.statistic:.2f}, p = {t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} "
-                       f"< {self.alpha:g})")
+                       f"< {self.alpha:g}){why}")
         return tuple(out)
 
 

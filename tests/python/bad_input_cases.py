@@ -330,6 +330,29 @@ def python_cases():
         Case("moderated_noise-few-lines", "value", lambda: lp().moderated_noise(mod_fd(12)),
              check=lambda m: m.prior_dof == 0 and np.all(m.dof[1:-1] == 6)),
     ]
+    # disturbances that are not periodic in the record
+    def dist_uy(P=4, N=64):
+        rng = np.random.default_rng(0)
+        u = rng.standard_normal((P, N))
+        return u, 2 * u + 0.1 * rng.standard_normal((P, N))
+
+    C += [
+        Case("disturbances-u-1d", "shape", lambda: lp().disturbances(np.ones(64), dist_uy()[1]), match=names("u")),
+        Case("disturbances-y-str", "type", lambda: lp().disturbances(dist_uy()[0], "abc"), match=names("y")),
+        Case("disturbances-y-nan", "nan/inf", lambda: lp().disturbances(dist_uy()[0], np.where(np.eye(4, 64) > 0, NaN, dist_uy()[1])),
+             match=names("y")),
+        Case("disturbances-shapes", "shape", lambda: lp().disturbances(dist_uy()[0], dist_uy()[1][:, :-1]),
+             match=names("u and y")),
+        Case("disturbances-one-period", "value", lambda: lp().disturbances(*[x[:1] for x in dist_uy()]), match=names("u")),
+        Case("disturbances-alpha-zero", "range", lambda: lp().disturbances(*dist_uy(), alpha=0.0), match=names("alpha")),
+        Case("disturbances-alpha-str", "type", lambda: lp().disturbances(*dist_uy(), alpha="x"), match=names("alpha")),
+        Case("disturbances-max_count-negative", "range", lambda: lp().disturbances(*dist_uy(), max_count=-1),
+             match=names("max_count")),
+        Case("disturbances-max_count-2**63", "overflow", lambda: lp().disturbances(*dist_uy(), max_count=2**63),
+             match=with_value("max_count", 2**63)),
+        Case("disturbances-short-record", "value", lambda: lp().disturbances(*dist_uy(2, 8)),
+             check=lambda out: out.found == ()),
+    ]
     # one record with its transient
     def rec():
         from lptv.examples import discrete_model, transient_record
@@ -630,7 +653,14 @@ def python_cases():
           Case("identify-noise-int", "type", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
                noise=1), match=names("noise")),
           Case("identify-noise-moderated-bootstrap", "value", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
-               noise="moderated", covariance="bootstrap"), match=names("noise"))]
+               noise="moderated", covariance="bootstrap"), match=names("noise")),
+          Case("identify-disturbances-bogus", "value", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               disturbances="subtract"), match=names("disturbances")),
+          Case("identify-disturbances-true", "type", lambda: lp().identify(*periods(), na=1, nb=0, w0=0.1,
+               disturbances=True), match=names("disturbances")),
+          Case("identify-disturbances-frequency-data", "value", lambda: lp().identify(
+               lp().FrequencyData.from_periods(*periods(), w0=0.1), na=1, nb=0, disturbances="remove"),
+               match=names("disturbances"))]
 
     C += family("floquet", "tol", lambda v: lp().floquet(ltv(), tol=v), FLOAT_BAD)
     C += family("floquet", "min_truncation", lambda v: lp().floquet(ltv(), min_truncation=v), INT_BAD)

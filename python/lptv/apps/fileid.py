@@ -204,6 +204,9 @@ def add_parser(sub):
                    help="the noise variances the fit weighs by: each line's own from its periods (default), "
                    "or moderated across neighbouring lines (smooth noise spectra; more precise estimates and "
                    "calibrated intervals at few periods; one record or --joint)")
+    p.add_argument("--remove-disturbances", action="store_true",
+                   help="find the sinusoids that are not periodic in the record (off the period's grid, "
+                   "such as mains hum) and subtract them before the fit (lptv.disturbances; one record)")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
@@ -229,7 +232,8 @@ def _one_line(problem) -> str:
 
 OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_iter": "--max-iter",
                 "tol": "--tol", "lines": "--lines", "known": "--known", "method": "--method", "w0": "--w0",
-                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap", "noise": "--noise"}
+                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap", "noise": "--noise",
+                "disturbances": "--remove-disturbances"}
 """The arguments of lptv.identify and the options that set them, for the messages."""
 
 
@@ -249,6 +253,11 @@ def run(args) -> int:
     if args.noise != "sample" and not args.joint and (len(args.files) > 1 or args.workers is not None
                                                       or args.scheduler is not None):
         print("lptv identify: error: --noise moderated takes one record or --joint (not a batch of files, "
+              "--workers or --scheduler)", file=sys.stderr)
+        return 2
+    if args.remove_disturbances and (args.joint or len(args.files) > 1 or args.workers is not None
+                                     or args.scheduler is not None):
+        print("lptv identify: error: --remove-disturbances takes one record (not several files, --joint, "
               "--workers or --scheduler)", file=sys.stderr)
         return 2
     if args.resume and (args.joint or (len(args.files) == 1 and args.workers is None and args.scheduler is None)):
@@ -285,6 +294,9 @@ def run(args) -> int:
         if args.discrete:
             args.ts = ts
         w0 = fundamental(args, meas)
+        if meas.realisations and args.remove_disturbances:
+            raise FileError("--remove-disturbances takes a record of periods of one realisation, not M x P x N "
+                            "realisations")
         if meas.realisations:
             from lptv.apps import blaid
 
@@ -298,7 +310,8 @@ def run(args) -> int:
             res = identify(meas.u, meas.y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                            lines=lines, method=args.method, known=known, tol=args.tol,
                            max_iter=args.max_iter, covariance=args.covariance, bootstrap=args.bootstrap,
-                           seed=0, noise=args.noise)
+                           seed=0, noise=args.noise,
+                           disturbances="remove" if args.remove_disturbances else None)
             Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
     except (FileError, ValueError, NumericalError) as e:
         return _fail(src, e)
@@ -335,6 +348,8 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
         "file": str(args.files[0]), "format": meas.format, "periods": P, "samples_per_period": N,
         "w0": w0, "ts": args.ts, "na": res.model.na, "nb": res.model.nb,
         "ka": ka, "kb": kb, "method": res.method, "noise": res.noise,
+        "disturbances_removed": [{"signal": d.signal, "line": d.line, "amplitude": d.amplitude, "phase": d.phase}
+                                 for d in res.disturbances],
         "n_lines": int(res.lines.size), "first_line": int(res.lines.min()),
         "last_line": int(res.lines.max()), "n_free_parameters": res.n_free_parameters,
         "iterations": res.iterations, "converged": res.converged, "cost": res.cost,
