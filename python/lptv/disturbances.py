@@ -93,6 +93,17 @@ def _local_level(p2, valid, half_width):
     return np.interp(np.arange(p2.size), centres, meds)
 
 
+def _threshold(M, alpha, n_level):
+    """t with P(max of M bins' |R|^2 / lambda_hat > t) = alpha: |R|^2 / lambda ~ Exp(1), and
+    lambda_hat = lambda (1 + eps) from the median of n_level bins, eps about N(0, s^2) with
+    s = 1 / (ln 2 sqrt(n_level)) (the median of Exp(1) has asymptotic variance 1 / n), so that
+    P(|R|^2 / lambda_hat > t) = exp(-t + t^2 s^2 / 2) and t - t^2 s^2 / 2 = ln(M / alpha)."""
+    L = float(np.log(max(M, 1) / alpha))
+    s2 = 1.0 / (np.log(2.0) ** 2 * max(n_level, 1))
+    disc = 1.0 - 2.0 * s2 * L
+    return (1.0 - np.sqrt(disc)) / s2 if disc > 0 else 2.0 * L
+
+
 def _fit_at(r, n, f, P, N):
     """Least squares of r on cos and sin at f (cycles per sample), as r sees them (minus their
     periodic means): (reduction of sum r^2, coefficients)."""
@@ -109,7 +120,7 @@ def _find(x, P, N, alpha, max_count, half_width, name):
     k = np.arange(M_total // 2 + 1)
     valid = (k % P != 0) & (k > 0) & (2 * k < M_total)
     M = int(valid.sum())
-    threshold = float(np.log(max(M, 1) / alpha))
+    threshold = _threshold(M, alpha, min(M, 2 * half_width + 1))
     found = []
     if M < 2 * half_width + 1:
         return x.reshape(P, N), found, threshold
