@@ -199,10 +199,9 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         offsets.append(_offset_groups(srt, ex))
         sdiag = np.diag(S_blocks[-1]).copy()
         for x, par_x in extensions.items():
-            part = _score_part(d, par_x, srt, res.model, sdiag)
+            part = _score_part(d, par_x, srt, res.model, sdiag, nus[-1])
             if part is not None:
-                # the periods the variances are worth: 1 + dof / 2
-                score_parts[x].append(part + (P if nu_line is None else 1.0 + float(nus[-1].min()) / 2,))
+                score_parts[x].append(part)
     if not order:
         return None
     order = np.concatenate(order)
@@ -326,14 +325,15 @@ def _extra_names(par_x, name):
     return [names.index(f"{name}.re{K}"), names.index(f"{name}.im{K}")]
 
 
-def _score_part(d, par_x, rows, model, sdiag):
+def _score_part(d, par_x, rows, model, sdiag, nu_rows):
     """One experiment's share of the score test for the extension par_x at the fitted model
     (the extra harmonic zero): s = J^T S^-1 r and F = J^T S^-1 J over the free entries of xi,
-    the real Jacobian over them and the residue variances (for the degrees of freedom); rows
-    whose lines +-K' leave the data are left out. None when nothing is left. ``rows`` are sorted
-    and ``sdiag`` is the diagonal of the fit's residue covariance on them (interleaved Re, Im):
-    with the extra harmonic zero the extended structure's residues are the fit's, and so is
-    their covariance."""
+    the real Jacobian over them, the residue variances and the rows' degrees of freedom (for
+    the small-sample factor and the degrees of freedom); rows whose lines +-K' leave the data
+    are left out. None when nothing is left. ``rows`` are sorted, ``sdiag`` is the diagonal of
+    the fit's residue covariance on them (interleaved Re, Im): with the extra harmonic zero the
+    extended structure's residues are the fit's, and so is their covariance; ``nu_rows`` the
+    degrees of freedom of each row's noise (co)variances."""
     K = par_x.structure.kmax
     keep = np.asarray(rows) + K <= d.max_line
     ok = [int(l) for l in np.asarray(rows)[keep]]
@@ -352,7 +352,7 @@ def _score_part(d, par_x, rows, model, sdiag):
         Sd = sdiag[np.repeat(keep, 2)]
     except (_core.NumericalError, ValueError):
         return None
-    return s, F, Jr[:, free], Sd
+    return s, F, Jr[:, free], Sd, np.asarray(nu_rows, float)[keep]
 
 
 def _score_test(parts, par_x, name):
@@ -360,15 +360,17 @@ def _score_test(parts, par_x, name):
     (two real parameters) from the experiments' parts: the efficient score
     s_e - F_et F_tt^-1 s_t with covariance F_ee - F_et F_tt^-1 F_te (valid at any root-n
     consistent fit of the restricted model, WGTLS as well as SML), its quadratic form LM
-    divided by the small-sample factor (P-2)/(P-3) of noise (co)variances estimated from P
-    periods (METHOD.md section 10), against 2 F(2, nu) with nu the rows' Satterthwaite degrees
-    of freedom. Returns (F value, p-value), or None (2 or 3 periods, nothing to test)."""
+    divided by the small-sample factor of noise (co)variances with nu degrees of freedom,
+    (nu - 2)/(nu - 4) ((P-2)/(P-3) for the sample variances of P periods, METHOD.md section
+    10), averaged over the rows with their shares c_l of the score's variance, against
+    2 F(2, nu_eff) with nu_eff the rows' Satterthwaite degrees of freedom. Returns (F value,
+    p-value), or None (a row with fewer than 6 degrees of freedom: 2 or 3 periods; nothing to
+    test)."""
     from scipy import stats
 
     if not parts:
         return None
-    Ps = [p[4] for p in parts]
-    if any(2 <= P < 4 for P in Ps):
+    if any(np.any(p[4] < 6) for p in parts):
         return None
     s = sum(p[0] for p in parts)
     F = sum(p[1] for p in parts)
@@ -382,16 +384,17 @@ def _score_test(parts, par_x, name):
         LM = float(se @ np.linalg.solve(Ve, se))
     except np.linalg.LinAlgError:
         return None
-    P = min(Ps)
-    kappa = (P - 2) / (P - 3) if P >= 4 else 1.0
     c_all, nu_all = [], []
-    for (_, _, Jf, Sd, Pe) in parts:
+    for (_, _, Jf, Sd, nu_rows) in parts:
         Jp = Jf[:, e] - Jf[:, t] @ X
         c = (Jp**2).sum(axis=1) / Sd
         c_all.append(c[0::2] + c[1::2])
-        nu_all.append(np.full(c.size // 2, 2.0 * (Pe - 1) if Pe >= 2 else np.inf))
+        nu_all.append(nu_rows)
     c, nu = np.concatenate(c_all), np.concatenate(nu_all)
     fin = np.isfinite(nu) & (c > 0)
+    kap = np.ones(c.size)
+    kap[fin] = (nu[fin] - 2.0) / (nu[fin] - 4.0)
+    kappa = float(np.sum(c * kap) / c.sum()) if c.sum() > 0 else 1.0
     Fval = LM / (2.0 * kappa)
     if fin.any():
         nu_eff = c.sum() ** 2 / np.sum(c[fin] ** 2 / nu[fin])
