@@ -640,8 +640,9 @@ def fit_record(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike,
         Fit T(z) = sum_{j=1}^{n} c_j z^j, n = max(na, nb); continuous time
         T = sum_{j=0}^{d} c_j (j w_l ts)^j.
     noise_var : ndarray, optional
-        E|V_l|^2 per fitted line; None: from the fit's residual, averaged over 2 noise_width + 1
-        lines and debiased for the parameters, then the fit repeated ``reweightings`` times.
+        E|V_l|^2 per fitted line; None: from the fit's residual, each line's over its share
+        1 - h_l (h_l its leverage), averaged over 2 noise_width + 1 lines, then the fit repeated
+        ``reweightings`` times.
     noise_width, reweightings : int
     max_iterations : int
         Levenberg-Marquardt iterations per fit.
