@@ -461,6 +461,7 @@ def test_remove_disturbances_option(tmp_path, capsys):
     np.testing.assert_allclose(lptv.Model.load(tmp_path / "o" / "model.json").covariance, ref.covariance,
                                rtol=1e-9, atol=0)
     rc, out, err = identify_cli(capsys, src, *args, "--out", tmp_path / "o2")
-    assert rc == 0 and "too small" in out and "lptv.disturbances" in out
+    assert rc == 0 and "too small" in out and "lptv.disturbances" in out and "hint: " in out
+    assert "--remove-disturbances finds and removes it" in out
     rc, out, err = identify_cli(capsys, src, src, *args, "--remove-disturbances")
     assert rc == 2 and "--remove-disturbances takes one record" in err and err.count("\n") == 1

@@ -329,6 +329,9 @@ def run(args) -> int:
     print(res.summary())
     for msg in extra:
         print(f"warning: {msg}")
+    if not args.remove_disturbances and any("too small" in e for e in res.model_errors):
+        print("hint: residues below the noise: if the structure is not over-fitted, a sinusoid that is not "
+              "periodic in the record may inflate the noise estimate; --remove-disturbances finds and removes it")
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
     failed = write_fit(out, res.model, summary, lambda: _report(src, meas, res, Y_pred, summary))
     return _fail(failed[0] or src, failed[1]) if failed else 0
