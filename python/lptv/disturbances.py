@@ -12,7 +12,7 @@ removes them; ``lptv.identify(u, y, ..., disturbances="remove")`` does it before
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Tuple
 
 import numpy as np
@@ -55,7 +55,12 @@ class DisturbanceResult:
     y: np.ndarray
     """The output periods with the output's disturbances subtracted."""
     threshold: float
-    """The detection threshold ln(M / alpha) for these records."""
+    """The detection threshold for these records (METHOD.md section 7: ln(M / alpha), raised for
+    the sampling error of the local noise level)."""
+    spectra: dict = field(default_factory=dict, repr=False)
+    """Per signal ('u', 'y'): (position in lines k / P, |R_k|^2, the local noise level lambda_k)
+    of the deviation's spectrum before any removal, on the bins searched (what
+    :func:`lptv.plots.disturbances` draws)."""
 
     def summary(self) -> str:
         """One line per disturbance, or a line saying there is none."""
@@ -122,12 +127,17 @@ def _find(x, P, N, alpha, max_count, half_width, name):
     M = int(valid.sum())
     threshold = _threshold(M, alpha, min(M, 2 * half_width + 1))
     found = []
+    spectrum = None
     if M < 2 * half_width + 1:
-        return x.reshape(P, N), found, threshold
-    for _ in range(max_count):
+        return x.reshape(P, N), found, threshold, spectrum
+    for it in range(max(max_count, 1)):
         r = _deviation(x, P, N)
         p2 = np.abs(np.fft.rfft(r)) ** 2
         level = _local_level(p2, valid, half_width)
+        if it == 0:
+            spectrum = (k[valid] / P, p2[valid], level[valid])
+        if it >= max_count:
+            break
         ratio = np.where(valid & (level > 0), p2 / np.where(level > 0, level, 1.0), 0.0)
         k0 = int(np.argmax(ratio))
         if ratio[k0] <= threshold:
@@ -146,7 +156,7 @@ def _find(x, P, N, alpha, max_count, half_width, name):
         x -= coef[0] * np.cos(w) + coef[1] * np.sin(w)
         found.append(Disturbance(signal=name, line=float(f * N), amplitude=float(np.hypot(*coef)),
                                  phase=float(np.arctan2(-coef[1], coef[0])), level=float(ratio[k0])))
-    return x.reshape(P, N), found, threshold
+    return x.reshape(P, N), found, threshold, spectrum
 
 
 def disturbances(u, y, *, alpha: float = ALPHA, max_count: int = 8) -> DisturbanceResult:
@@ -173,7 +183,7 @@ def disturbances(u, y, *, alpha: float = ALPHA, max_count: int = 8) -> Disturban
     -------
     DisturbanceResult
         ``.found`` (the sinusoids, input's first), ``.u``, ``.y`` (the periods without them),
-        ``.summary()``.
+        ``.summary()``; :func:`lptv.plots.disturbances` draws what was searched.
 
     Examples
     --------
@@ -194,6 +204,7 @@ def disturbances(u, y, *, alpha: float = ALPHA, max_count: int = 8) -> Disturban
     alpha = as_float(alpha, "alpha", minimum=0.0, open_min=True, maximum=0.5)
     max_count = as_int(max_count, "max_count", minimum=0)
     P, N = u.shape
-    u2, fu, threshold = _find(u, P, N, alpha, max_count, HALF_WIDTH, "u")
-    y2, fy, _ = _find(y, P, N, alpha, max_count, HALF_WIDTH, "y")
-    return DisturbanceResult(found=tuple(fu + fy), u=u2, y=y2, threshold=threshold)
+    u2, fu, threshold, su = _find(u, P, N, alpha, max_count, HALF_WIDTH, "u")
+    y2, fy, _, sy = _find(y, P, N, alpha, max_count, HALF_WIDTH, "y")
+    spectra = {name: sp for name, sp in (("u", su), ("y", sy)) if sp is not None}
+    return DisturbanceResult(found=tuple(fu + fy), u=u2, y=y2, threshold=threshold, spectra=spectra)

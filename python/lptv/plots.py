@@ -303,6 +303,60 @@ def moderated_noise(mod, *, hz: bool = False, ax=None):
     return ax
 
 
+def disturbances(result, *, w0: float = None, hz: bool = False, fig=None):
+    """What :func:`lptv.disturbances` searched: per signal (input, output), the power of the
+    periods' deviation from their mean on the record's grid (P bins per line) against its local
+    noise level and the detection threshold, with the sinusoids found marked.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> rng = np.random.default_rng(0)
+    >>> P, N = 8, 512
+    >>> n = np.arange(P * N)
+    >>> y = (0.01 * rng.standard_normal(P * N) + 0.05 * np.cos(2 * np.pi * 40.37 * n / N)).reshape(P, N)
+    >>> u = np.tile(np.cos(2 * np.pi * 3 * np.arange(N) / N), (P, 1)) + 0.01 * rng.standard_normal((P, N))
+    >>> fig = lptv.plots.disturbances(lptv.disturbances(u, y))
+    >>> [ax.get_title() for ax in fig.axes]
+    ['input: nothing found', 'output: 1 sinusoid off the grid']
+    """
+    import matplotlib.pyplot as plt
+
+    from .disturbances import DisturbanceResult
+    from ._validate import as_bool, as_float
+
+    if not isinstance(result, DisturbanceResult):
+        raise ValueError(f"result must be an lptv.DisturbanceResult (from lptv.disturbances), got {type(result).__name__}")
+    hz = as_bool(hz, "hz")
+    if w0 is not None:
+        w0 = as_float(w0, "w0", minimum=0.0, open_min=True)
+    if not result.spectra:
+        raise ValueError("result holds no spectra: the records were too short to search")
+    if fig is None:
+        fig = plt.figure(figsize=(6.4, 2.6 * len(result.spectra)))
+    names = {"u": "input", "y": "output"}
+    axes = fig.subplots(len(result.spectra), 1, squeeze=False)[:, 0]
+    for ax, (sig, (pos, p2, level)) in zip(axes, result.spectra.items()):
+        x, label = (pos, "line (cycles per period)") if w0 is None else _freq_axis(pos, w0, hz)
+        ax.plot(x, 10 * np.log10(np.maximum(p2, 1e-300)), ".", ms=2, color="C0", alpha=0.5,
+                label="deviation from the periodic mean")
+        ax.plot(x, 10 * np.log10(np.maximum(level, 1e-300)), "-", lw=1, color="C2", label="local noise level")
+        ax.plot(x, 10 * np.log10(np.maximum(level * result.threshold, 1e-300)), "--", lw=1, color="C3",
+                label="detection threshold")
+        mine = [d for d in result.found if d.signal == sig]
+        for d in mine:
+            xd = d.line if w0 is None else _freq_axis(np.array([d.line]), w0, hz)[0][0]
+            ax.axvline(xd, color="C3", lw=0.8, alpha=0.6)
+        ax.set_title(f"{names[sig]}: " + (f"{len(mine)} sinusoid{'s' if len(mine) > 1 else ''} off the grid"
+                                           if mine else "nothing found"))
+        ax.set_xlabel(label)
+        ax.set_ylabel("power (dB)")
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize="small", loc="upper right")
+    fig.tight_layout()
+    return fig
+
+
 def residue_tests(res, *, ax=None):
     """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`) as bars: each
     test's statistic z (standard normal without a model error) with the level at which the

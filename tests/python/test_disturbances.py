@@ -135,3 +135,26 @@ def test_bad_arguments_are_refused_with_the_argument_named():
         lptv.identify(data, **d["structure"], disturbances="remove")
     with pytest.raises(ValueError, match="experiments\\[1\\]"):
         lptv.identify([(u, y), data], **d["structure"], w0=d["w0"], disturbances="remove")
+
+
+def test_the_plot_shows_what_was_searched(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import lptv.plots
+
+    d, u, y, y_h, _ = hummed(1)
+    out = lptv.disturbances(u, y_h)
+    assert set(out.spectra) == {"u", "y"}
+    pos, p2, level = out.spectra["y"]
+    assert pos.size == p2.size == level.size and np.all(pos % 1 != 0)     # never a line of the grid
+    peak = pos[np.argmax(p2 / level)]
+    assert abs(peak - HUM_LINE) < 1.0 / y.shape[0]                          # the peak is the hum's bin
+    fig = lptv.plots.disturbances(out, w0=d["w0"])
+    assert [ax.get_title() for ax in fig.axes] == ["input: nothing found", "output: 1 sinusoid off the grid"]
+    assert fig.axes[1].get_xlabel() == "angular frequency (rad/s)"
+    fig.savefig(tmp_path / "disturbances.png")
+    with pytest.raises(ValueError, match="result must be an lptv.DisturbanceResult"):
+        lptv.plots.disturbances(out.found)
+    with pytest.raises(ValueError, match="w0"):
+        lptv.plots.disturbances(out, w0=-1.0)
