@@ -697,7 +697,7 @@ def _without_disturbances(u, y, several):
     from .disturbances import disturbances as find
 
     def clean(uu, yy, where):
-        if isinstance(uu, FrequencyData) or yy is None:
+        if isinstance(uu, FrequencyData):
             raise ValueError(f"disturbances='remove' needs the periods (u, y), not FrequencyData{where}: "
                              "the spectra no longer hold what differs between the periods")
         try:
@@ -707,16 +707,17 @@ def _without_disturbances(u, y, several):
         return out.u, out.y, out.found
 
     if not several:
-        u2, y2, found = clean(u, y, "")
-        return u2, y2, found
+        return clean(u, y, "")
     items, found = [], []
     for i, item in enumerate(u):
         if isinstance(item, (list, tuple)) and len(item) == 2:
             uu, yy, f = clean(item[0], item[1], f" (experiments[{i}])")
             items.append((uu, yy))
             found.extend(f)
-        else:
-            clean(item, None, f" (experiments[{i}])")
+        else:   # FrequencyData is refused here; anything else, experiments_of reports
+            if isinstance(item, FrequencyData):
+                clean(item, None, f" (experiments[{i}])")
+            items.append(item)
     return items, None, tuple(found)
 
 

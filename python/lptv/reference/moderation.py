@@ -109,29 +109,8 @@ def _window_sums(x: np.ndarray, keep: np.ndarray, W: int):
 
 
 def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
-    """The noise (co)variances of ``data`` moderated across neighbouring lines.
-
-    Per line l (1 .. Lmax - 1) the moderated covariance matrix of the mean input and output is
-    (d C_l + d0 C0_l) / (d + d0): C_l the line's sample (co)variances (d = 2 (P - 1) real degrees
-    of freedom), C0_l the prior scale, (d0 - 2) / d0 times the mean of C over the lines within
-    +-``half_width`` of l (l itself and outlying lines excluded), d0 estimated from the spread of
-    log varU and log varY about their local means (Smyth 2004's moment estimator, made local).
-    Lines 0 and Lmax, and lines far above their neighbours, keep their own (co)variances.
-
-    Parameters
-    ----------
-    data : lptv.FrequencyData
-        Spectra and noise statistics from P >= 2 periods.
-    half_width : int
-        The neighbours of a line: the lines within +-half_width (default 10). Wider windows
-        moderate more but follow a changing noise spectrum less closely (the estimated d0 then
-        drops: the rule stays calibrated and moderates less).
-
-    Returns
-    -------
-    ModeratedNoise
-        With ``prior_dof`` 0 and the data unchanged when it cannot be formed (fewer than
-        ``3 half_width`` lines with noise, statistics not from periods).
+    """:func:`lptv.moderated_noise` (its arguments, result and method, METHOD.md section 7) in
+    NumPy and SciPy: the independent route the core's is tested against.
 
     Examples
     --------
