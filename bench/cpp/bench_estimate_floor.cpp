@@ -26,6 +26,8 @@
 #include "bench_common.hpp"
 #include "lptv/estimators.hpp"
 #include "lptv/fds.hpp"
+#include "lptv/jacobian.hpp"
+#include "lptv/likelihood.hpp"
 #include "lptv/noise.hpp"
 #include "rows.hpp"  // lptv::detail::SingleThreadedBlas (private: the benchmarks are in-tree)
 
@@ -115,6 +117,33 @@ int main(int argc, char** argv) {
   const lptv::Parametrisation p = paper_parametrisation();
   std::vector<int> rows;
   for (int l = 1; l <= 243; ++l) rows.push_back(l);
+  if (argc > 3 && std::string(argv[1]) == "--loop" && std::string(argv[2]) == "covariance-terms") {
+    // WGTLS's covariance terms at its estimate: the first-order sandwich and the second-order
+    // terms, each timed alone (ms per call, fastest of 5 rounds of SECONDS / 10 each).
+    const lptv::FrequencyData d = measurements(1);
+    lptv::EstimateOptions o;
+    o.tol = 1e-12;
+    const lptv::EstimateResult er = lptv::estimate(d, p, rows, o);
+    const lptv::ExactLikelihood lik(d, p, rows);
+    Eigen::VectorXd w = lptv::residue_variance(d, p, rows, er.theta).cwiseInverse();
+    auto time = [&](auto&& f) {
+      double best = 1e30;
+      for (int round = 0; round < 5; ++round) {
+        const auto t0 = std::chrono::steady_clock::now();
+        int n = 0;
+        while (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < std::atof(argv[3]) / 10) {
+          f();
+          ++n;
+        }
+        best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / n);
+      }
+      return best;
+    };
+    const double t1 = time([&] { (void)lik.sandwich_terms(er.theta, w); });
+    const double t2 = time([&] { (void)lptv::second_order_meat(lik.second_order_terms(er.theta, w), p, er.theta); });
+    std::printf("sandwich terms %.3f ms, second-order terms %.3f ms\n", t1, t2);
+    return 0;
+  }
   if (argc > 3 && std::string(argv[1]) == "--loop") {
     const lptv::FrequencyData d = measurements(1);
     const std::string what = argv[2];

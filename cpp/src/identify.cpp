@@ -241,11 +241,15 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
             cov_free = ldlt.solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
             cov_free = 0.5 * (cov_free + cov_free.transpose()).eval();
           } else {
-            cov_free = lik.sandwich_covariance(er.theta, w);
+            // The sandwich with the estimating equation's second-order noise in its meat.
+            const auto t = lik.sandwich_terms(er.theta, w);
+            cov_free = sandwich_from_terms(
+                t.bread, t.meat + second_order_meat(lik.second_order_terms(er.theta, w), p, er.theta));
           }
         } else {
           // Independent experiments: informations (and both sandwich terms) add.
           Eigen::MatrixXd bread, meat;
+          ExactLikelihood::SecondOrderTerms second;
           Eigen::Index at = 0;
           for (size_t e = 0; e < E; ++e) {
             const Eigen::Index n = static_cast<Eigen::Index>(rows[e].size());
@@ -259,10 +263,17 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
               if (e == 0) bread = F; else bread += F;
             } else {
               const auto t = lik.sandwich_terms(er.theta, w.segment(at, n));
-              if (e == 0) { bread = t.bread; meat = t.meat; } else { bread += t.bread; meat += t.meat; }
+              const auto so = lik.second_order_terms(er.theta, w.segment(at, n));
+              if (e == 0) {
+                bread = t.bread; meat = t.meat; second = so;
+              } else {
+                bread += t.bread; meat += t.meat; second += so;
+              }
             }
             at += n;
           }
+          // One lambda for all experiments: the second-order terms add before they combine.
+          if (opt.method != Method::SML) meat += second_order_meat(second, p, er.theta);
           if (opt.method == Method::SML) {
             Eigen::LDLT<Eigen::MatrixXd> ldlt(bread);
             if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0))
@@ -278,7 +289,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
         } else {
           res.covariance = eta_covariance(p, cov_free);
           res.warnings.push_back(
-              "the covariance is first-order only: with noise variances from " + std::to_string(P) +
+              "the covariance has no small-sample correction: with noise variances from " + std::to_string(P) +
               " periods the estimate's variance is not finite in theory (4 periods or more are needed "
               "for calibrated intervals)");
         }
@@ -287,6 +298,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
         // bread is the plain sum and each experiment's meat (for SML its information) carries
         // its own covariance_correction(P_e) (METHOD.md section 14).
         Eigen::MatrixXd bread, meat;
+        ExactLikelihood::SecondOrderTerms second;
         Eigen::Index at = 0;
         std::vector<int> first_order;
         for (size_t e = 0; e < E; ++e) {
@@ -305,16 +317,24 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
             auto t = lik.sandwich_terms(er.theta, w.segment(at, n));
             Be = std::move(t.bread);
             Me = c * t.meat;
+            // Its second-order terms with the experiment's factor (CJ_W, which only gives
+            // lambda's direction, as it is).
+            auto so = lik.second_order_terms(er.theta, w.segment(at, n));
+            so.qq *= c;
+            so.qr *= c;
+            so.rr *= c;
+            if (e == 0) second = std::move(so); else second += so;
           }
           if (e == 0) { bread = Be; meat = Me; } else { bread += Be; meat += Me; }
           at += n;
         }
+        if (opt.method != Method::SML) meat += second_order_meat(second, p, er.theta);
         res.covariance = eta_covariance(p, sandwich_from_terms(bread, meat));
         if (!first_order.empty()) {
           std::string which;
           for (int e : first_order) which += (which.empty() ? "" : ", ") + std::to_string(e);
           res.warnings.push_back(
-              "the covariance is first-order only for experiment(s) " + which +
+              "the covariance has no small-sample correction for experiment(s) " + which +
               ": with noise variances from fewer than 4 periods the estimate's variance is not finite in "
               "theory (4 periods or more are needed for calibrated intervals)");
         }

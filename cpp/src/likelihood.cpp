@@ -38,6 +38,12 @@ void entry_map(cd a, cd b, bool conjugate, double G[2][4]) {
   }
 }
 
+// a b without the NaN recovery of std::complex's operator* (a library call on every product
+// that checks its result): the same value for finite operands.
+inline cd mul(cd a, cd b) {
+  return cd(a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real());
+}
+
 // Cov(n_m), 4 x 4 (METHOD.md section 10).
 void line_covariance(const FrequencyData& d, int m, double C[4][4]) {
   const double cy = d.varY[m], cu = d.varU[m];
@@ -442,6 +448,232 @@ ExactLikelihood::SandwichTerms ExactLikelihood::sandwich_terms(const Eigen::Vect
     t.bread = Xt * J;
   }
   return t;
+}
+
+ExactLikelihood::SecondOrderTerms& ExactLikelihood::SecondOrderTerms::operator+=(const SecondOrderTerms& o) {
+  qq += o.qq;
+  qr += o.qr;
+  rr += o.rr;
+  cj += o.cj;
+  return *this;
+}
+
+// Row pairs (r, r2) that read one signed line i (row r at harmonic k = l - i, row r2 at
+// k2 = l2 - i; lines i and -i are different noise for a circular line, conjugates of each
+// other). With f_q = +-s_i^n the Jacobian's factor of theta_q and E_qq2 = E{conj(dX^q_i) dX^q2_i}
+// (var Y, var U or the cross-covariance, by the sides of q and q2), Isserlis' theorem for
+// circular Gaussian noise gives, over ordered pairs of rows,
+//   Cov(Q_q, Q_q2)  = sum w_l w_l' E{conj(dJ_lq) dJ_l'q2} S_ll'     (Q = sum_l w_l conj(dJ_l) e_l)
+//   Cov(Q_q, R)     = sum w_l w_l' E{conj(dJ_lq) e_l'} S_ll'
+//   Var(R)          = sum w_l w_l' |S_ll'|^2
+//   E{Q_q Q_q2}     = sum w_l w_l' g_q(l, l') g_q2(l', l),  g_q(l, l') = E{conj(dJ_lq) e_l'}
+// with S_ll' = E{e_l conj(e_l')} (METHOD.md section 10). Real xi coordinates: q = Re(Text^H Q),
+// so Cov(q) = Re(Text^H Cov(Q) Text + Text^H E{Q Q^T} conj(Text)) / 2 and
+// Cov(q, R) = Re(Text^H Cov(Q, R)). E{Q Q^T} is a sum of outer products of the columns g(l, l')
+// and w_l w_l' g(l', l), gathered per row offset l' - l (their harmonics depend on it alone) and
+// multiplied out in blocks.
+ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eigen::VectorXcd& theta,
+                                                                     const Eigen::VectorXd& weights) const {
+  if (theta.size() != p_.n_theta()) throw std::invalid_argument("theta has the wrong size");
+  const int R = static_cast<int>(sorted_.size()), W = 2 * K_ + 1, nt = p_.n_theta();
+  if (weights.size() != R) throw std::invalid_argument("weights must have one entry per row");
+  const Structure& st = p_.structure();
+  const detail::Lines X{d_};
+  const detail::HarmonicCoefficients hc = detail::by_harmonic(p_, theta);
+  detail::RowPowers pw(st);
+  // theta's entries ordered by harmonic (the rows of E{Q Q^T}'s blocks are ranges of it).
+  const std::vector<std::vector<int>> group = detail::params_by_harmonic(p_);
+  std::vector<int> perm, gstart(static_cast<size_t>(W) + 1), pos(static_cast<size_t>(nt));
+  for (int kk = 0; kk < W; ++kk) {
+    gstart[static_cast<size_t>(kk)] = static_cast<int>(perm.size());
+    for (int q : group[static_cast<size_t>(kk)]) {
+      pos[static_cast<size_t>(q)] = static_cast<int>(perm.size());
+      perm.push_back(q);
+    }
+  }
+  gstart[static_cast<size_t>(W)] = nt;
+  // Per sorted row r and harmonic k (slot r W + K + k): the band entries a = A_{l,i}, b = B_{l,i}
+  // of the signed line i = l - k, its noise (co)variances, and per parameter x of harmonic k
+  // (in perm order from gstart[K + k]) f_x = +-s_i^n, uY_x = conj(f_x) E{conj(dX^x) dY_i},
+  // uU_x = conj(f_x) E{conj(dX^x) dU_i}.
+  struct Slot {
+    cd a, b, cyu;
+    double vy, vu;
+  };
+  std::vector<Slot> slot(static_cast<size_t>(R) * W);
+  std::vector<cd> fx(static_cast<size_t>(R) * nt), uY(static_cast<size_t>(R) * nt), uU(static_cast<size_t>(R) * nt);
+  std::vector<char> isa(static_cast<size_t>(nt));
+  for (int x = 0; x < nt; ++x) isa[static_cast<size_t>(x)] = p_.params()[static_cast<size_t>(perm[static_cast<size_t>(x)])].is_a;
+  std::vector<double> w(static_cast<size_t>(R));
+  std::vector<cd> A, B;
+  for (int r = 0; r < R; ++r) {
+    pw.compute(sorted_[r]);
+    detail::band_row(hc, pw, A, B);
+    for (int k = -K_; k <= K_; ++k) {
+      const int i = sorted_[r] - k;
+      Slot& s = slot[static_cast<size_t>(r) * W + K_ + k];
+      s.a = A[static_cast<size_t>(K_ + k)];
+      s.b = B[static_cast<size_t>(K_ + k)];
+      s.vy = X.varY(i);
+      s.vu = X.varU(i);
+      s.cyu = X.covYU(i);
+      for (int x = gstart[static_cast<size_t>(K_ + k)]; x < gstart[static_cast<size_t>(K_ + k + 1)]; ++x) {
+        const Param& pr = p_.params()[static_cast<size_t>(perm[static_cast<size_t>(x)])];
+        const cd f = (pr.is_a ? 1.0 : -1.0) * pw(k, pr.order);
+        const size_t at = static_cast<size_t>(r) * nt + x;
+        fx[at] = f;
+        uY[at] = std::conj(f) * (pr.is_a ? cd(s.vy, 0.0) : s.cyu);
+        uU[at] = std::conj(f) * (pr.is_a ? std::conj(s.cyu) : cd(s.vu, 0.0));
+      }
+    }
+    w[static_cast<size_t>(r)] = std::max(weights[order_[r]], 0.0);
+  }
+  // E{Q Q^T} = sum over ordered row pairs (l, l') of w w' g(l, l') g(l', l)^T, symmetric: the
+  // pair (l', l) adds the transpose of (l, l')'s term, so E{Q Q^T} = P0 + P + P^T with P over
+  // the pairs l < l' and P0 over l = l'. For l' - l = delta >= 0, g(l, l') lives on the
+  // harmonics k with |delta + k| <= K, g(l', l) on those with |k - delta| <= K: one buffer of
+  // columns per delta, multiplied out when full.
+  constexpr int kCap = 64;
+  // Real arithmetic: with Ga = Ar + j Ai, Gb = Br + j Bi, Ga Gb^T = [Ar Ai] [Br -Bi]^T
+  // + j [Ar Ai] [Bi Br]^T, one real product of A = [Ar Ai] and B = [[Br -Bi]; [Bi Br]].
+  struct Buffer {
+    int a0 = 0, na = 0, b0 = 0, nb = 0, used = 0;
+    Eigen::MatrixXd A, B;  // na x 2 kCap; 2 nb x 2 kCap
+    void add_a(int row, int col, cd v) {
+      A(row, col) += v.real();
+      A(row, kCap + col) += v.imag();
+    }
+    void add_b(int row, int col, cd v) {
+      B(row, col) += v.real();
+      B(row, kCap + col) -= v.imag();
+      B(nb + row, col) += v.imag();
+      B(nb + row, kCap + col) += v.real();
+    }
+  };
+  std::vector<Buffer> buf(static_cast<size_t>(2 * K_ + 1));
+  for (int delta = 0; delta <= 2 * K_; ++delta) {
+    Buffer& bf = buf[static_cast<size_t>(delta)];
+    const int ka0 = -K_, ka1 = K_ - delta, kb0 = delta - K_, kb1 = K_;
+    bf.a0 = gstart[static_cast<size_t>(K_ + ka0)];
+    bf.na = gstart[static_cast<size_t>(K_ + ka1 + 1)] - bf.a0;
+    bf.b0 = gstart[static_cast<size_t>(K_ + kb0)];
+    bf.nb = gstart[static_cast<size_t>(K_ + kb1 + 1)] - bf.b0;
+    bf.A = Eigen::MatrixXd::Zero(bf.na, 2 * kCap);
+    bf.B = Eigen::MatrixXd::Zero(2 * bf.nb, 2 * kCap);
+  }
+  Eigen::MatrixXd Pri = Eigen::MatrixXd::Zero(nt, 2 * nt), Pri0 = Eigen::MatrixXd::Zero(nt, 2 * nt);  // [Re Im], perm order
+  auto flush = [&](Buffer& bf, bool diagonal) {
+    if (bf.used == 0) return;
+    Eigen::MatrixXd prod(bf.na, 2 * bf.nb);
+    prod.noalias() = bf.A * bf.B.transpose();
+    Eigen::MatrixXd& target = diagonal ? Pri0 : Pri;
+    target.block(bf.a0, bf.b0, bf.na, bf.nb) += prod.leftCols(bf.nb);
+    target.block(bf.a0, nt + bf.b0, bf.na, bf.nb) += prod.rightCols(bf.nb);
+    bf.A.setZero();
+    bf.B.setZero();
+    bf.used = 0;
+  };
+  Eigen::MatrixXcd G = Eigen::MatrixXcd::Zero(nt, nt), Gd = Eigen::MatrixXcd::Zero(nt, nt),
+                   C = Eigen::MatrixXcd::Zero(nt, nt);  // perm order
+  Eigen::VectorXcd tau = Eigen::VectorXcd::Zero(nt);
+  double rr = 0;
+  for (int r = 0; r < R; ++r) {
+    const int l = sorted_[r];
+    for (int r2 = r; r2 < std::min(R, r + 2 * K_ + 1); ++r2) {
+      const int l2 = sorted_[r2], delta = l2 - l;
+      if (delta > 2 * K_) break;
+      const int klo = std::max(-K_, -K_ - delta), khi = std::min(K_, K_ - delta);  // l reads i = l - k, l2 reads it too
+      cd S(0.0, 0.0);  // E{e_l conj(e_l2)} over the signed lines both rows read
+      for (int k = klo; k <= khi; ++k) {
+        const Slot& s1 = slot[static_cast<size_t>(r) * W + K_ + k];
+        const Slot& s2 = slot[static_cast<size_t>(r2) * W + K_ + k + delta];
+        S += s1.vy * mul(s1.a, std::conj(s2.a)) - mul(mul(s1.a, std::conj(s2.b)), s1.cyu) -
+             mul(mul(s1.b, std::conj(s2.a)), std::conj(s1.cyu)) + s1.vu * mul(s1.b, std::conj(s2.b));
+      }
+      const double ww = w[static_cast<size_t>(r)] * w[static_cast<size_t>(r2)];
+      rr += (r == r2 ? 1.0 : 2.0) * ww * std::norm(S);
+      const cd wS = ww * S;
+      Buffer& fwd = buf[static_cast<size_t>(delta)];
+      const int cf = fwd.used;
+      Eigen::MatrixXcd& target = (r == r2) ? Gd : G;
+      for (int k = klo; k <= khi; ++k) {
+        const int k2 = k + delta;
+        const Slot& s1 = slot[static_cast<size_t>(r) * W + K_ + k];
+        const Slot& s2 = slot[static_cast<size_t>(r2) * W + K_ + k2];
+        const int x0 = gstart[static_cast<size_t>(K_ + k)], x1 = gstart[static_cast<size_t>(K_ + k + 1)];
+        const int y0 = gstart[static_cast<size_t>(K_ + k2)], y1 = gstart[static_cast<size_t>(K_ + k2 + 1)];
+        const cd* uY1 = &uY[static_cast<size_t>(r) * nt];
+        const cd* uU1 = &uU[static_cast<size_t>(r) * nt];
+        const cd* uY2 = &uY[static_cast<size_t>(r2) * nt];
+        const cd* uU2 = &uU[static_cast<size_t>(r2) * nt];
+        const cd* f2 = &fx[static_cast<size_t>(r2) * nt];
+        for (int y = y0; y < y1; ++y) {  // E{conj(dJ_lx) dJ_l2y} S: Y- or U-side moments by y's side
+          const cd wf = mul(wS, f2[y]);
+          const cd* u1 = isa[static_cast<size_t>(y)] ? uY1 : uU1;
+          for (int x = x0; x < x1; ++x) target(x, y) += mul(wf, u1[x]);
+          if (r == r2) {
+            const cd wf1 = w[static_cast<size_t>(r)] * f2[y];
+            for (int x = x0; x < x1; ++x) C(x, y) += mul(wf1, u1[x]);
+          }
+        }
+        for (int x = x0; x < x1; ++x) {  // dJ on row l, the residue on row l2: g_x(l, l2)
+          const cd g = mul(s2.a, uY1[x]) - mul(s2.b, uU1[x]);
+          tau[x] += mul(wS, g);
+          fwd.add_a(x - fwd.a0, cf, g);
+          if (r == r2) fwd.add_b(x - fwd.b0, cf, ww * g);
+        }
+        if (r != r2) {  // dJ on row l2, the residue on row l: g_y(l2, l); S_{l2 l} = conj(S_{l l2})
+          for (int y = y0; y < y1; ++y) {
+            const cd g = mul(s1.a, uY2[y]) - mul(s1.b, uU2[y]);
+            tau[y] += mul(std::conj(wS), g);
+            fwd.add_b(y - fwd.b0, cf, ww * g);
+          }
+        }
+      }
+      if (++fwd.used == kCap) flush(fwd, delta == 0);
+    }
+  }
+  for (int delta = 0; delta <= 2 * K_; ++delta) flush(buf[static_cast<size_t>(delta)], delta == 0);
+  Eigen::MatrixXcd Pi(nt, nt);
+  for (int j = 0; j < nt; ++j)
+    for (int i = 0; i < nt; ++i)
+      Pi(i, j) = cd(Pri(i, j) + Pri(j, i) + Pri0(i, j), Pri(i, nt + j) + Pri(j, nt + i) + Pri0(i, nt + j));
+  // Back to theta's order, then to real xi coordinates.
+  const Eigen::MatrixXcd Gamma = G + G.adjoint() + Gd;
+  Eigen::MatrixXcd P(nt, nt), Gm(nt, nt), Cm(nt, nt);
+  Eigen::VectorXcd tm(nt);
+  for (int i = 0; i < nt; ++i) {
+    tm[perm[static_cast<size_t>(i)]] = tau[i];
+    for (int j = 0; j < nt; ++j) {
+      P(perm[static_cast<size_t>(i)], perm[static_cast<size_t>(j)]) = Pi(i, j);
+      Gm(perm[static_cast<size_t>(i)], perm[static_cast<size_t>(j)]) = Gamma(i, j);
+      Cm(perm[static_cast<size_t>(i)], perm[static_cast<size_t>(j)]) = C(i, j);
+    }
+  }
+  const Eigen::MatrixXcd& T = p_.Text();
+  SecondOrderTerms t;
+  t.qq = 0.5 * (T.adjoint() * Gm * T + T.adjoint() * P * T.conjugate()).real();
+  t.qq = (0.5 * (t.qq + t.qq.transpose())).eval();
+  t.qr = (T.adjoint() * tm).real();
+  t.rr = rr;
+  t.cj = (T.adjoint() * Cm * T).real();
+  t.cj = (0.5 * (t.cj + t.cj.transpose())).eval();
+  return t;
+}
+
+Eigen::MatrixXd second_order_meat(const ExactLikelihood::SecondOrderTerms& t, const Parametrisation& p,
+                                  const Eigen::VectorXcd& theta) {
+  const Eigen::VectorXd xi = p.xi_from_theta(theta);
+  const Eigen::VectorXd cx = t.cj * xi;
+  const double xcx = xi.dot(cx);
+  const Eigen::VectorXd v = xcx > 0 ? Eigen::VectorXd(cx / xcx) : Eigen::VectorXd::Zero(xi.size());
+  Eigen::MatrixXd M = t.qq - t.qr * v.transpose() - v * t.qr.transpose() + t.rr * v * v.transpose();
+  const std::vector<int> free = p.free_indices();
+  const Eigen::Index nf = static_cast<Eigen::Index>(free.size());
+  Eigen::MatrixXd out(nf, nf);
+  for (Eigen::Index a = 0; a < nf; ++a)
+    for (Eigen::Index b = 0; b < nf; ++b) out(a, b) = 0.5 * (M(free[a], free[b]) + M(free[b], free[a]));
+  return out;
 }
 
 namespace {

@@ -19,6 +19,15 @@ void bind_likelihood(py::module_& m) {
            py::call_guard<py::gil_scoped_release>())
       .def("sandwich_covariance", &lptv::ExactLikelihood::sandwich_covariance, "theta"_a, "weights"_a,
            py::call_guard<py::gil_scoped_release>())
+      .def(
+          "second_order_meat",
+          [](const lptv::ExactLikelihood& lik, const lptv::Parametrisation& par, const Eigen::VectorXcd& theta,
+             const Eigen::VectorXd& weights) {
+            return lptv::second_order_meat(lik.second_order_terms(theta, weights), par, theta);
+          },
+          "par"_a, "theta"_a, "weights"_a, py::call_guard<py::gil_scoped_release>(),
+          "Cov(q - lambda CJ_W xi) over the free entries of xi: the second-order noise of WGTLS's "
+          "estimating equation (METHOD.md section 10), one experiment.")
       .def("residue_covariance", &lptv::ExactLikelihood::residue_covariance, "theta"_a)
       .def_property_readonly("sorted_rows", &lptv::ExactLikelihood::sorted_rows)
       .def_property_readonly("half_bandwidth", &lptv::ExactLikelihood::half_bandwidth);

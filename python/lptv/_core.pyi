@@ -213,6 +213,10 @@ class ExactLikelihood:
         ...
     def sandwich_covariance(self, theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
+    def second_order_meat(self, par: Parametrisation, theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Cov(q - lambda CJ_W xi) over the free entries of xi: the second-order noise of WGTLS's estimating equation (METHOD.md section 10), one experiment.
+        """
     @property
     def half_bandwidth(self) -> int:
         ...

@@ -532,8 +532,10 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
         ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
     covariance : {'analytic', 'bootstrap'}
-        WGTLS, SML: how ``res.covariance`` is obtained. 'analytic' (default): the first-order
-        sandwich of the estimating equation times (P-1)/(P-3) (METHOD.md section 10).
+        WGTLS, SML: how ``res.covariance`` is obtained. 'analytic' (default): SML's inverse
+        Fisher information; WGTLS's sandwich of its estimating equation to second order in the
+        noise (the noise of the Jacobian times that of the residue counts where rows carry
+        little signal); both times (P-1)/(P-3) (METHOD.md section 10).
         'bootstrap': the covariance of ``bootstrap`` refits of data sets drawn from the fitted
         model and the measured noise (co)variances, P periods each (`lptv.bootstrap`), which
         follows the randomness of the noise weights at small P where the factor does not

@@ -152,12 +152,18 @@ def test_estimators_match_reference(seed, domain, lti, method, id_tol):
         assert res.converged and rr["converged"] and res.iterations == rr["iterations"]
         assert rel(res.theta, s.theta) < 0.1  # consistent: near the truth at this SNR
         # The covariance: the sandwich summed over experiments, each meat with its own
-        # (P-1)/(P-3) (P = 5, 8, 6 differ), at the denoised data of the reference.
+        # (P-1)/(P-3) (P = 5, 8, 6 differ), at the denoised data of the reference; the
+        # second-order terms with the same factors, summed before they combine (one lambda).
         w = 1.0 / np.maximum(v, ref.VARIANCE_FLOOR * v.max())
-        bread, meat, at = 0.0, 0.0, 0
+        bread, meat, at, second = 0.0, 0.0, 0, None
         for d, r in zip(datas, rows):
+            c = (d.periods - 1) / (d.periods - 3)
             H, Mt = lk.sandwich_terms(d, s.par, r, rr["theta"], w[at:at + r.size])
-            bread, meat, at = bread + H, meat + (d.periods - 1) / (d.periods - 3) * Mt, at + r.size
+            t = lk.second_order_terms(d, s.par, r, rr["theta"], w[at:at + r.size])
+            t = dict(qq=c * t["qq"], qr=c * t["qr"], rr=c * t["rr"], cj=t["cj"])
+            second = t if second is None else {k: second[k] + t[k] for k in t}
+            bread, meat, at = bread + H, meat + c * Mt, at + r.size
+        meat = meat + lk.second_order_meat(second, s.par, rr["theta"])
         Hinv = np.linalg.inv(bread)
         cov = lk._eta_covariance(s.par, Hinv @ meat @ Hinv)
         assert rel(res.covariance, cov) <= COVARIANCE

@@ -60,6 +60,21 @@ class ExactLikelihood {
   };
   SandwichTerms sandwich_terms(const Eigen::VectorXcd& theta, const Eigen::VectorXd& weights) const;
 
+  // The second-order part of WGTLS's estimating equation (METHOD.md section 10): at the
+  // estimate, with dJ the noise of the Jacobian and r0 = dJ xi that of the residue, the
+  // equation's noise is q - lambda CJ_W xi, q = dJ^T W r0 (second order in the noise, zero
+  // mean after the bias correction), lambda = R / (xi^T CJ_W xi), R = r0^T W r0. Its pieces
+  // for one experiment, in xi coordinates (all n_xi entries), for Gaussian noise circular on
+  // every line (a DC line read by a row is taken as circular too):
+  struct SecondOrderTerms {
+    Eigen::MatrixXd qq;  // Cov(q)
+    Eigen::VectorXd qr;  // Cov(q, R)
+    double rr = 0;       // Var(R)
+    Eigen::MatrixXd cj;  // CJ_W = E{dJ^T W dJ}
+    SecondOrderTerms& operator+=(const SecondOrderTerms& o);
+  };
+  SecondOrderTerms second_order_terms(const Eigen::VectorXcd& theta, const Eigen::VectorXd& weights) const;
+
   // S in dense form, sorted-row order (for tests and small problems).
   Eigen::MatrixXd residue_covariance(const Eigen::VectorXcd& theta) const;
 
@@ -109,6 +124,13 @@ ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& 
 // its gradient and the Gauss-Newton information are the sums of the experiments' own.
 ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
                              const Eigen::VectorXcd& theta0, double tol, int max_iter);
+
+// Cov(q - lambda CJ_W xi) over the free entries of xi (free_indices order) from the terms of
+// one experiment or their sum over independent experiments (one lambda for all):
+// Cov(q) - c v^T - v c^T + Var(R) v v^T, c = Cov(q, R), v = CJ_W xi / (xi^T CJ_W xi).
+// Added to the sandwich's meat it gives WGTLS's covariance to second order in the noise.
+Eigen::MatrixXd second_order_meat(const ExactLikelihood::SecondOrderTerms& t, const Parametrisation& p,
+                                  const Eigen::VectorXcd& theta);
 
 // H^{-1} meat H^{-1} (symmetrised); NumericalError when H is singular.
 Eigen::MatrixXd sandwich_from_terms(const Eigen::MatrixXd& bread, const Eigen::MatrixXd& meat);

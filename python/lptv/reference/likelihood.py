@@ -23,12 +23,13 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from .identification import Data, Parametrisation, band_rows
+from .identification import Data, Parametrisation, band_rows, line_variable
 
 __all__ = [
     "noise_vector_covariance", "data_vector", "residue_map", "residue_covariance", "exact_cost",
     "exact_cost_gradient", "fisher_information", "crb", "sml_estimate", "xi_of_theta",
     "crb_experiments", "sml_estimate_experiments", "sandwich_terms", "exact_cost_experiments", "denoised",
+    "second_order_terms", "second_order_meat",
 ]
 
 
@@ -233,6 +234,79 @@ def sandwich_terms(data: Data, par: Parametrisation, rows, theta, weights):
     W = np.repeat(np.asarray(weights, float), 2)
     WJ = W[:, None] * J
     return J.T @ WJ, WJ.T @ S @ WJ
+
+
+def second_order_terms(data: Data, par: Parametrisation, rows, theta, weights) -> dict:
+    """The pieces of the second-order noise of WGTLS's estimating equation (METHOD.md section 10),
+    densely, over the complex noise of the signed lines i (line -m the conjugate of line m,
+    independent of it for circular noise; the DC line taken as circular too):
+    nu_i = [dY_i, dU_i], E{nu_i nu_i^H} = [[var Y, cov YU], [conj cov YU, var U]] (conjugated on a
+    negative line). With the complex maps e = M nu (the residue), dJ[:, q] = D_q nu (column q of
+    the Jacobian), S = M Sigma M^H, w the row weights and Q_q = sum_l w_l conj(dJ_lq) e_l,
+    R = sum_l w_l |e_l|^2, Isserlis' theorem gives
+
+        E{Q_q conj(Q_q2)} = sum_{l,l'} w_l w_l' [conj(D_q) conj(Sigma) D_q2^T]_{l l'} S_{l l'}
+        E{Q_q Q_q2}       = sum_{l,l'} w_l w_l' G_q[l, l'] G_q2[l', l],  G_q = conj(D_q) conj(Sigma) M^T
+        Cov(Q_q, R)       = sum_{l,l'} w_l w_l' G_q[l, l'] S_{l l'}
+        Var(R)            = sum_{l,l'} w_l w_l' |S_{l l'}|^2
+
+    (centred), and in real xi coordinates (q = Re(Text^H Q)): 'qq' = Re(Text^H E{Q Q^H} Text
+    + Text^H E{Q Q^T} conj(Text)) / 2, 'qr' = Re(Text^H Cov(Q, R)), 'rr' = Var(R) and
+    'cj' = Re(Text^H C Text), C = sum_l w_l E{dJ_l^H dJ_l}."""
+    rows = np.asarray(rows)
+    K = par.K
+    k = np.arange(-K, K + 1)
+    lines = rows[:, None] - k[None, :]                      # signed line of each band entry
+    signed = np.arange(lines.min(), lines.max() + 1)
+    pos = {int(i): j for j, i in enumerate(signed)}
+    ns = signed.size
+    R = rows.size
+    Sig = np.zeros((2 * ns, 2 * ns), complex)
+    for j, i in enumerate(signed):
+        m = abs(int(i))
+        c = complex(data.covYU[m]) if i >= 0 else complex(np.conj(data.covYU[m]))
+        Sig[2 * j:2 * j + 2, 2 * j:2 * j + 2] = [[data.varY[m], c], [np.conj(c), data.varU[m]]]
+    A, B = band_rows(par, theta, rows)
+    Mc = np.zeros((R, 2 * ns), complex)
+    for r in range(R):
+        for c in range(2 * K + 1):
+            j = pos[int(lines[r, c])]
+            Mc[r, 2 * j] += A[r, c]
+            Mc[r, 2 * j + 1] -= B[r, c]
+    n_theta = len(par.params)
+    D = np.zeros((n_theta, R, 2 * ns), complex)
+    for q, (is_a, n, kq) in enumerate(par.params):
+        i = rows - kq
+        f = (1.0 if is_a else -1.0) * line_variable(par, i) ** n
+        for r in range(R):
+            D[q, r, 2 * pos[int(i[r])] + (0 if is_a else 1)] = f[r]
+    w = np.asarray(weights, float)
+    S = Mc @ Sig @ Mc.conj().T
+    Om = np.outer(w, w) * S
+    Z = np.einsum("qls,st->qlt", D.conj(), Sig.conj())      # conj(D_q) conj(Sigma)
+    OD = np.einsum("lm,qms->qls", Om, D)                   # Omega D_q2
+    Gamma = np.einsum("qls,pls->qp", Z, OD)
+    G = np.einsum("qls,ms->qlm", Z, Mc)                    # E{conj(dJ_lq) e_m}
+    Pi = np.einsum("qlm,pml,l,m->qp", G, G, w, w)
+    tau = np.einsum("qls,ls->q", Z, Om @ Mc)
+    Cc = np.einsum("qls,pls->qp", Z * w[None, :, None], D)
+    T = par.Text
+    qq = 0.5 * (T.conj().T @ Gamma @ T + T.conj().T @ Pi @ T.conj()).real
+    return dict(qq=0.5 * (qq + qq.T), qr=(T.conj().T @ tau).real,
+                rr=float(np.sum(np.outer(w, w) * np.abs(S) ** 2)), cj=(T.conj().T @ Cc @ T).real)
+
+
+def second_order_meat(terms: dict, par: Parametrisation, theta) -> np.ndarray:
+    """Cov(q - lambda CJ_W xi) over the free entries of xi, lambda = R / (xi^T CJ_W xi): with
+    v = CJ_W xi / (xi^T CJ_W xi), Cov(q) - c v^T - v c^T + Var(R) v v^T, c = Cov(q, R). The terms
+    of independent experiments add first (one lambda for all)."""
+    xi = xi_of_theta(par, theta)  # theta = Text xi, at the scale theta has
+    cx = terms["cj"] @ xi
+    v = cx / (xi @ cx)
+    M = terms["qq"] - np.outer(terms["qr"], v) - np.outer(v, terms["qr"]) + terms["rr"] * np.outer(v, v)
+    free = _free(par)
+    M = M[np.ix_(free, free)]
+    return 0.5 * (M + M.T)
 
 
 def sml_estimate_experiments(datas, par: Parametrisation, rows_list, theta0, *, tol: float = 1e-13,
