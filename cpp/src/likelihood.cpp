@@ -569,8 +569,10 @@ ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eige
     Eigen::MatrixXd& target = diagonal ? Pri0 : Pri;
     target.block(bf.a0, bf.b0, bf.na, bf.nb) += prod.leftCols(bf.nb);
     target.block(bf.a0, nt + bf.b0, bf.na, bf.nb) += prod.rightCols(bf.nb);
-    bf.A.setZero();
-    bf.B.setZero();
+    bf.A.leftCols(bf.used).setZero();
+    bf.A.middleCols(kCap, bf.used).setZero();
+    bf.B.leftCols(bf.used).setZero();
+    bf.B.middleCols(kCap, bf.used).setZero();
     bf.used = 0;
   };
   Eigen::MatrixXcd G = Eigen::MatrixXcd::Zero(nt, nt), Gd = Eigen::MatrixXcd::Zero(nt, nt),
