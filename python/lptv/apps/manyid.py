@@ -37,15 +37,17 @@ def _error(problem) -> int:
 
 def executor_of(args):
     """(executor, workers) from --workers / --scheduler. With a scheduler, the Dask client's own
-    log (a traceback per failed reconnection when the scheduler is lost) is silenced: the command
-    says what was lost and how to resume in one line."""
+    log is silenced (a traceback per failed reconnection when the scheduler is lost, from
+    distributed.client; the closed batched stream's, from distributed.batched; tornado's callbacks):
+    the command says what was lost and how to resume in one line."""
     if args.scheduler is not None:
         import contextlib
         import logging
 
         with contextlib.suppress(ImportError):
-            import distributed  # noqa: F401 - its import configures its loggers: set the level after
-        logging.getLogger("distributed.client").setLevel(logging.CRITICAL)
+            import distributed  # noqa: F401 - its import configures its loggers: set the levels after
+        for name in ("distributed", "distributed.client", "tornado", "tornado.application"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
         return args.scheduler, None
     if args.workers is not None:
         if args.workers < 1:
