@@ -36,8 +36,9 @@ def core_data(d):
 
 @cases
 @pytest.mark.parametrize("which", ["near_dc", "default"])
-def test_second_order_meat_matches_reference(seed, domain, lti, which):
-    case = make_case(seed, domain, lti)
+@pytest.mark.parametrize("known", [False, True], ids=["free", "known_a2"])
+def test_second_order_meat_matches_reference(seed, domain, lti, which, known):
+    case = make_case(seed, domain, lti, known=known)
     rng = np.random.default_rng([seed, 11])
     d, rows = random_data(rng, case.L), [int(r) for r in rows_of(case, which)]
     lik = _core.ExactLikelihood(core_data(d), core_par(case), rows)
