@@ -197,6 +197,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         signal_rows.append(np.ones(srt.size, bool))
         ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
         offsets.append(_offset_groups(srt, ex))
+        offsets[-1][srt <= K] = -1     # rows that read DC or a conjugate line: in "rows with signal" only
         sdiag = np.diag(S_blocks[-1]).copy()
         for x, par_x in extensions.items():
             part = _score_part(d, par_x, srt, res.model, sdiag, nus[-1])

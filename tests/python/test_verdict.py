@@ -183,3 +183,18 @@ def test_score_test_sees_a_missing_harmonic_on_the_discrete_system(seed):
     assert any("one more harmonic on a0 would fit" in s for s in res.residue_tests.sentences())
     u0, y0t = noisy_periods(d["u0"], d["y0"], 8, seed=seed + 140, **d["noise"])
     assert _fit(dict(d, u=u0, y=y0t), "sml").model_ok
+
+
+def test_rows_reading_dc_or_a_conjugate_line_are_judged_with_all_rows_only():
+    """Rows l <= K read line 0 (real noise) or a conjugate line: their residues are not
+    circular, which the offset groups' normal scores assume; they enter 'rows with signal' only
+    (METHOD.md section 7, item 3). The discrete-time system, K = 2, rows from line 1."""
+    d = system_measurements("discrete", seed=3, periods=4)
+    res = _fit(d)
+    K = max(max(d["structure"]["ka"]), max(d["structure"]["kb"]))
+    assert np.min(res.lines) <= K  # the fit has such rows
+    tests = res.residue_tests.tests
+    every = [t for t in tests if t.name == "rows with signal"][0]
+    assert np.any(every.rows <= K)
+    groups = [t for t in tests if t.name.startswith("rows ") and t.name != "rows with signal"]
+    assert groups and all(np.all(t.rows > K) for t in groups)
