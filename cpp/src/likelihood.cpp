@@ -38,8 +38,9 @@ void entry_map(cd a, cd b, bool conjugate, double G[2][4]) {
   }
 }
 
-// a b without the NaN recovery of std::complex's operator* (a library call on every product
-// that checks its result): the same value for finite operands.
+// a b by the textbook formula, without the NaN recovery of std::complex's operator* (a test
+// of every product's result and, on NaN, a library call): what the second-order terms'
+// inner loops multiply with.
 inline cd mul(cd a, cd b) {
   return cd(a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real());
 }
@@ -483,13 +484,10 @@ ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eige
   detail::RowPowers pw(st);
   // theta's entries ordered by harmonic (the rows of E{Q Q^T}'s blocks are ranges of it).
   const std::vector<std::vector<int>> group = detail::params_by_harmonic(p_);
-  std::vector<int> perm, gstart(static_cast<size_t>(W) + 1), pos(static_cast<size_t>(nt));
+  std::vector<int> perm, gstart(static_cast<size_t>(W) + 1);
   for (int kk = 0; kk < W; ++kk) {
     gstart[static_cast<size_t>(kk)] = static_cast<int>(perm.size());
-    for (int q : group[static_cast<size_t>(kk)]) {
-      pos[static_cast<size_t>(q)] = static_cast<int>(perm.size());
-      perm.push_back(q);
-    }
+    for (int q : group[static_cast<size_t>(kk)]) perm.push_back(q);
   }
   gstart[static_cast<size_t>(W)] = nt;
   // Per sorted row r and harmonic k (slot r W + K + k): the band entries a = A_{l,i}, b = B_{l,i}

@@ -8,7 +8,8 @@ cannot dilute:
 
 - per *offset group*: the rows at the same distance |d| from their nearest excited line,
   pooled over the excited lines (a missing harmonic or order acts alike at every excited
-  line);
+  line); rows l <= K, which read DC or a conjugate line (residues that are not circular), are
+  judged in the next test only;
 - over all judged rows, two-sided (residues too large: a model error; too small: residues
   that the fit has absorbed, an over-fitted structure or a wrong noise level).
 
