@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "lptv/errors.hpp"
+#include "lptv/estimators.hpp"
 #include "lptv/jacobian.hpp"
 #include "rows.hpp"
 
@@ -573,8 +574,7 @@ ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eige
     bf.B.middleCols(kCap, bf.used).setZero();
     bf.used = 0;
   };
-  Eigen::MatrixXcd G = Eigen::MatrixXcd::Zero(nt, nt), Gd = Eigen::MatrixXcd::Zero(nt, nt),
-                   C = Eigen::MatrixXcd::Zero(nt, nt);  // perm order
+  Eigen::MatrixXcd G = Eigen::MatrixXcd::Zero(nt, nt), Gd = Eigen::MatrixXcd::Zero(nt, nt);  // perm order
   Eigen::VectorXcd tau = Eigen::VectorXcd::Zero(nt);
   double rr = 0;
   for (int r = 0; r < R; ++r) {
@@ -611,10 +611,6 @@ ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eige
           const cd wf = mul(wS, f2[y]);
           const cd* u1 = isa[static_cast<size_t>(y)] ? uY1 : uU1;
           for (int x = x0; x < x1; ++x) target(x, y) += mul(wf, u1[x]);
-          if (r == r2) {
-            const cd wf1 = w[static_cast<size_t>(r)] * f2[y];
-            for (int x = x0; x < x1; ++x) C(x, y) += mul(wf1, u1[x]);
-          }
         }
         for (int x = x0; x < x1; ++x) {  // dJ on row l, the residue on row l2: g_x(l, l2)
           const cd g = mul(s2.a, uY1[x]) - mul(s2.b, uU1[x]);
@@ -640,14 +636,13 @@ ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eige
       Pi(i, j) = cd(Pri(i, j) + Pri(j, i) + Pri0(i, j), Pri(i, nt + j) + Pri(j, nt + i) + Pri0(i, nt + j));
   // Back to theta's order, then to real xi coordinates.
   const Eigen::MatrixXcd Gamma = G + G.adjoint() + Gd;
-  Eigen::MatrixXcd P(nt, nt), Gm(nt, nt), Cm(nt, nt);
+  Eigen::MatrixXcd P(nt, nt), Gm(nt, nt);
   Eigen::VectorXcd tm(nt);
   for (int i = 0; i < nt; ++i) {
     tm[perm[static_cast<size_t>(i)]] = tau[i];
     for (int j = 0; j < nt; ++j) {
       P(perm[static_cast<size_t>(i)], perm[static_cast<size_t>(j)]) = Pi(i, j);
       Gm(perm[static_cast<size_t>(i)], perm[static_cast<size_t>(j)]) = Gamma(i, j);
-      Cm(perm[static_cast<size_t>(i)], perm[static_cast<size_t>(j)]) = C(i, j);
     }
   }
   const Eigen::MatrixXcd& T = p_.Text();
@@ -656,8 +651,9 @@ ExactLikelihood::SecondOrderTerms ExactLikelihood::second_order_terms(const Eige
   t.qq = (0.5 * (t.qq + t.qq.transpose())).eval();
   t.qr = (T.adjoint() * tm).real();
   t.rr = rr;
-  t.cj = (T.adjoint() * Cm * T).real();
-  t.cj = (0.5 * (t.cj + t.cj.transpose())).eval();
+  std::vector<int> rows(sorted_.size());  // the caller's order, as the weights are
+  for (size_t r = 0; r < sorted_.size(); ++r) rows[static_cast<size_t>(order_[r])] = sorted_[r];
+  t.cj = real_column_covariance(d_, p_, rows, weights.cwiseMax(0.0));
   return t;
 }
 

@@ -13,25 +13,12 @@ from lptv import _core
 from lptv.reference import identification as ref
 from lptv.reference import likelihood as lk
 
-from test_likelihood_reference import SEEDS, make_case, random_data, rows_of
+from test_likelihood_core import cases, core_data, core_par
+from test_likelihood_reference import make_case, random_data, rows_of
 
 # Both routes sum the same O(|R| K^2 n^2) products of O(1) numbers in different orders: a
 # rounding error of a few hundred eps relative to the largest entry.
 TERMS = 1e-11
-
-cases = pytest.mark.parametrize(
-    "seed,domain,lti", [(s, d, l) for s in SEEDS for d in ("ct", "dt") for l in (False, True)],
-    ids=lambda v: str(v) if not isinstance(v, bool) else ("lti" if v else "lptv"))
-
-
-def core_par(case):
-    p = case.par
-    known = [(is_a, n, row) for (is_a, n), row in p.known.items()]
-    return _core.Parametrisation(p.na, p.nb, p.ka, p.kb, known, p.w0, p.ts)
-
-
-def core_data(d):
-    return _core.FrequencyData(d.U, d.Y, d.varU, d.varY, d.covYU, d.periods)
 
 
 @cases
