@@ -107,8 +107,8 @@ Eigen::MatrixXd weighted_r_factor(const FrequencyData& d, const Parametrisation&
 Eigen::MatrixXd real_column_covariance(const FrequencyData& d, const Parametrisation& p,
                                        const std::vector<int>& rows, const Eigen::VectorXd& weights) {
   const Eigen::MatrixXcd C = column_covariance(d, p, rows, weights);
-  const Eigen::MatrixXcd& T = p.Text();
-  Eigen::MatrixXd CJ = (T.adjoint() * C * T).real();
+  const Eigen::MatrixXd CJ =
+      detail::real_congruence(p, detail::text_entries(p), [&](int a, int b) { return C(a, b); }, false);
   return 0.5 * (CJ + CJ.transpose());  // exact symmetry against rounding
 }
 

@@ -35,6 +35,13 @@ inline void jacobian_row(const Parametrisation& p, const Lines& X, const RowPowe
   }
 }
 
+// a b by the textbook formula, without the NaN recovery of std::complex's operator* (a test
+// of every product's result and, on NaN, a library call); the same bits where the product is
+// finite (no contraction: -ffp-contract=off). What the per-row inner loops multiply with.
+inline cd mul(cd a, cd b) {
+  return cd(a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real());
+}
+
 // Nonzeros of Text (theta = Text xi): theta_p contributes v to xi column c. One or two per row.
 struct TextEntry {
   int p, c;
@@ -47,6 +54,32 @@ inline std::vector<TextEntry> text_entries(const Parametrisation& p) {
   for (int c = 0; c < T.cols(); ++c)
     for (int q = 0; q < T.rows(); ++q)
       if (T(q, c) != cd(0.0, 0.0)) out.push_back({q, c, T(q, c)});
+  return out;
+}
+
+// Re(Text^H M Text) (conj_right false) or Re(Text^H M conj(Text)) (true), n_xi x n_xi, from
+// Text's nonzeros (text_entries, grouped by column): O(n_xi^2) products where the dense
+// triple product takes O(n_theta^3). M is given by its entries m(p, q) over theta's indices.
+template <class M>
+inline Eigen::MatrixXd real_congruence(const Parametrisation& p, const std::vector<TextEntry>& text, M&& m,
+                                       bool conj_right) {
+  const int nx = p.n_xi();
+  std::vector<int> start(static_cast<size_t>(nx) + 1, 0);
+  for (const TextEntry& e : text) ++start[static_cast<size_t>(e.c) + 1];
+  for (int c = 0; c < nx; ++c) start[static_cast<size_t>(c) + 1] += start[static_cast<size_t>(c)];
+  Eigen::MatrixXd out(nx, nx);
+  for (int b = 0; b < nx; ++b)
+    for (int a = 0; a < nx; ++a) {
+      double v = 0.0;
+      for (int i = start[static_cast<size_t>(a)]; i < start[static_cast<size_t>(a) + 1]; ++i) {
+        const TextEntry& ea = text[static_cast<size_t>(i)];
+        for (int j = start[static_cast<size_t>(b)]; j < start[static_cast<size_t>(b) + 1]; ++j) {
+          const TextEntry& eb = text[static_cast<size_t>(j)];
+          v += mul(mul(std::conj(ea.v), m(ea.p, eb.p)), conj_right ? std::conj(eb.v) : eb.v).real();
+        }
+      }
+      out(a, b) = v;
+    }
   return out;
 }
 
@@ -84,7 +117,7 @@ inline void noise_block_entries(const Parametrisation& p, const Lines& X, const 
       for (size_t b = 0; b < g.size(); ++b) {
         const bool yb = p.params()[static_cast<size_t>(g[b])].is_a;
         const cd e = ya ? (yb ? cd(vy, 0.0) : std::conj(cyu)) : (yb ? cyu : cd(vu, 0.0));
-        out(g[a], g[b], fa * f[b] * e);
+        out(g[a], g[b], mul(mul(fa, f[b]), e));
       }
     }
   }
