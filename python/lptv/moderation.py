@@ -58,6 +58,8 @@ class ModeratedNoise:
     """The input's own sample variances (of the mean) the moderation started from."""
     source_varY: np.ndarray = None
     """The output's own sample variances (of the mean)."""
+    source_covYU: np.ndarray = None
+    """The own sample cross-covariances E{dY conj(dU)} (of the mean)."""
     _core: object = field(default=None, repr=False, compare=False)
 
     def error_covariance(self, lines) -> np.ndarray:
@@ -127,11 +129,11 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     dof = np.array(core.dof, dtype=float)
     if not core.moderated:
         return ModeratedNoise(data=data, dof=dof, prior_dof=0.0, outliers=np.zeros(0, int), half_width=W,
-                              source_varU=vu, source_varY=vy, _core=core)
+                              source_varU=vu, source_varY=vy, source_covYU=data.covYU, _core=core)
     moderated = FrequencyData.__new__(FrequencyData)
     moderated._set(core.data, data.w0, data.ts)
     return ModeratedNoise(data=moderated, dof=dof, prior_dof=float(core.prior_dof),
                           outliers=np.asarray(core.outliers, int).reshape(-1), half_width=W,
                           own_weight=np.array(core.own_weight, dtype=float),
                           neighbour=np.array(core.neighbour, dtype=bool), source_varU=vu, source_varY=vy,
-                          _core=core)
+                          source_covYU=data.covYU, _core=core)
