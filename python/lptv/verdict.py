@@ -106,26 +106,6 @@ class ResidueTests:
         return tuple(out)
 
 
-def _unbiased(mo):
-    """The moderated (co)variances with their prior part at the neighbours' mean instead of
-    (d0 - 2) / d0 times it: w C_own + (1 - w) C_mean (METHOD.md section 7, item 2)."""
-    from .data import FrequencyData
-
-    m = mo.data
-    d0 = mo.prior_dof
-    if not (d0 > 2) or mo.own_weight is None or mo.source_covYU is None:
-        return m
-    f = d0 / (d0 - 2.0)
-    w = np.asarray(mo.own_weight, float)
-
-    def fix(mod, own):
-        mod, own = np.asarray(mod), np.asarray(own)
-        return w * own + (mod - w * own) * f
-
-    return FrequencyData(m.U, m.Y, fix(m.varU, mo.source_varU), fix(m.varY, mo.source_varY),
-                         fix(m.covYU, mo.source_covYU), w0=m.w0, ts=m.ts, periods=m.periods)
-
-
 def _signal_lines(d, P: int) -> np.ndarray:
     """Lines 0..max_line where the output or the input stands above its noise."""
     from scipy import stats
@@ -189,12 +169,12 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         fitted = res.moderation[e] if res.moderation else None
         if fitted is not None:        # the fit weighed by moderated variances: d holds them
             mo, nu_line = fitted, fitted.dof
-            d = _unbiased(mo)
+            d = mo.unbiased_data()
         elif MODERATE and P >= 2 and res.noise == "sample":
             from .moderation import moderated_noise
             mo = moderated_noise(d)
             if mo.prior_dof > 0:
-                d, nu_line = _unbiased(mo), mo.dof
+                d, nu_line = mo.unbiased_data(), mo.dof
         rows_e = np.sort(lines[idx])
         near = np.zeros(rows_e.size, bool)
         for k in range(-K, K + 1):

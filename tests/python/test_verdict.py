@@ -210,7 +210,6 @@ def test_the_verdicts_moderated_variances_are_unbiased_where_the_noise_is_flat()
     records whose estimated d0 is finite (about 40 % of them), the mean ratio to the true
     variance is 1 within 4 standard errors of the records' spread for the verdict's variances,
     and more than 4 below it for Smyth's."""
-    from lptv import verdict
     from lptv.examples import noise_variances
 
     ours, smyth = [], []
@@ -222,7 +221,7 @@ def test_the_verdicts_moderated_variances_are_unbiased_where_the_noise_is_flat()
             continue
         true = noise_variances(d["u0"], d["y0"], **d["noise"])[1] / 4
         inner = slice(1, np.asarray(data.varY).size - 1)
-        ours.append(np.mean(np.asarray(verdict._unbiased(mo).varY)[inner] / true[inner]))
+        ours.append(np.mean(np.asarray(mo.unbiased_data().varY)[inner] / true[inner]))
         smyth.append(np.mean(np.asarray(mo.data.varY)[inner] / true[inner]))
     ours, smyth = np.array(ours), np.array(smyth)
     assert ours.size >= 30
