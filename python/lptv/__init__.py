@@ -26,7 +26,7 @@ from .data import FrequencyData
 from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
 from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
-from .distortion import DistortionResult, distortion
+from .distortion import DistortionResult, LackOfFit, distortion
 from .record import RecordResult, identify_record
 from .floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
@@ -43,7 +43,7 @@ from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 __version__ = "0.1.0"
 
 __all__ = [
-    "BatchResult", "ConditioningWarning", "CramerRaoBound", "DistortionResult", "distortion", "FloquetResult", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS",
+    "BatchResult", "ConditioningWarning", "CramerRaoBound", "DistortionResult", "distortion", "LackOfFit", "FloquetResult", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS",
     "IdentificationResult", "Model", "MonteCarloResult", "Multisine", "NumericalError", "SimulationResult", "StabilityUndecidedWarning", "TruncationWarning", "UnstableModelWarning",
     "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
     "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",

@@ -50,6 +50,12 @@ class FrequencyData:
     (4, 32)
     """
 
+    distortion = None
+    """The :class:`lptv.DistortionResult` whose realisation this is (set by
+    :meth:`lptv.DistortionResult.experiments`), else None."""
+    realisation = None
+    """Its index among that result's realisations, else None."""
+
     def __init__(self, U, Y, varU, varY, covYU=None, *, w0: float, ts: Optional[float] = None,
                  periods: int = 0):
         U = _line_vector(U, "U", None, complex)

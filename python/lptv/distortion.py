@@ -26,6 +26,7 @@ the F tests and the overall statistic (SciPy) after it, here.
 """
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -36,6 +37,75 @@ from ._validate import as_int, as_positive_float
 from .data import FrequencyData
 
 ALPHA = 0.01
+
+
+LOF_ALL_PERMUTATIONS = 720
+"""Up to this many permutations of the realisations (M! <= 720, M <= 6) all are taken; beyond,
+the identity and ``LOF_RANDOM_PERMUTATIONS - 1`` drawn with a fixed seed (the p-value is then
+that of a randomisation test, as exact, with a resolution of 1 / LOF_RANDOM_PERMUTATIONS)."""
+LOF_RANDOM_PERMUTATIONS = 2000
+
+
+@dataclass(frozen=True)
+class LackOfFit:
+    """A parametric model of the best linear approximation judged against the per-line
+    regression across the realisations (:meth:`DistortionResult.lack_of_fit`, METHOD.md section
+    16, "Judging the parametric BLA"). Per judged output line j, with q_j regressors (the
+    realisations' excited lines within +-Kh) and the model's predicted output for each
+    realisation, the residual rows split into a lack of fit (their projection on the
+    regressors) and the pure error of the regression; without a model error their ratio is
+    F(2 q_j, 2 (M - q_j)). The lines' normal scores are summed and that sum is referred to its
+    distribution over the permutations of the realisations' residual rows against their
+    regressors (one permutation for all lines, so that the distortion's correlation across
+    lines is kept)."""
+
+    lines: np.ndarray
+    """The judged output lines."""
+    regressors: np.ndarray
+    """Per judged line: q_j, the rank of its regressors."""
+    F: np.ndarray
+    """Per judged line: (lack of fit / q_j) / (pure error / (M - q_j))."""
+    p_lines: np.ndarray
+    """Per judged line: P(F(2 q_j, 2 (M - q_j)) > F). Calibrated line by line; not the decision
+    (the extreme tails of the distortion are heavier than the F distribution's)."""
+    statistic: float
+    """The sum of the lines' normal scores Phi^-1(1 - p_j) over sqrt(their number)."""
+    p_value: float
+    """Its permutation p-value: the share of permutations (the identity included) whose sum is
+    at least the observed one. Reject when at or below ``alpha``."""
+    permutations: int
+    realisations: int
+    alpha: float = ALPHA
+
+    @property
+    def rejects(self) -> bool:
+        return bool(self.p_value <= self.alpha)
+
+    @property
+    def can_reject(self) -> bool:
+        """Whether the permutations can reach ``alpha`` at all (M >= 5 realisations)."""
+        return bool(1.0 / self.permutations <= self.alpha)
+
+    def worst(self, k: int = 3) -> np.ndarray:
+        """The ``k`` judged lines with the smallest line p-values."""
+        return self.lines[np.argsort(self.p_lines, kind="stable")[:k]]
+
+    def sentence(self) -> str:
+        side = "departs from" if self.statistic > 0 else "stays closer than its noise to"
+        return (f"the model {side} the best linear approximation that the {self.realisations} realisations give "
+                f"line by line (lack of fit on {self.lines.size} lines: z = {self.statistic:.2f}, permutation "
+                f"p = {self.p_value:.2g} <= {self.alpha:g}; largest on lines "
+                f"{', '.join(str(int(j)) for j in self.worst())})")
+
+
+def _permutations(M: int) -> np.ndarray:
+    import math
+
+    if math.factorial(M) <= LOF_ALL_PERMUTATIONS:
+        return np.array(list(itertools.permutations(range(M))), dtype=int)
+    rng = np.random.default_rng(20261126 + M)
+    rest = np.array([rng.permutation(M) for _ in range(LOF_RANDOM_PERMUTATIONS - 1)], dtype=int)
+    return np.vstack([np.arange(M)[None, :], rest])
 
 
 @dataclass(frozen=True)
@@ -124,7 +194,10 @@ class DistortionResult:
         :class:`lptv.FrequencyData`), each output variance raised by the nonlinear level
         (:meth:`nonlinear_smooth`), so that WGTLS and SML weigh the lines by noise and
         nonlinear distortion together and their parameter covariance includes both: the
-        parametric fit of the best linear time-periodic approximation.
+        parametric fit of the best linear time-periodic approximation. Each remembers this
+        result and its realisation (``distortion``, ``realisation``), so that a fit of all M of
+        them is judged by :meth:`lack_of_fit` (the verdict of section 7 assumes residues
+        independent across lines, which the distortion is not).
 
         Examples
         --------
@@ -148,9 +221,12 @@ class DistortionResult:
         """
         nl = self.nonlinear_smooth(width)
         out = []
-        for U, Y, varU, varY, cov in self.spectra:
-            out.append(FrequencyData(U, Y, varU, varY + nl[:varY.size], cov, w0=self.w0, ts=self.ts,
-                                     periods=self.effective_periods(varY, nl, width)))
+        for m, (U, Y, varU, varY, cov) in enumerate(self.spectra):
+            fd = FrequencyData(U, Y, varU, varY + nl[:varY.size], cov, w0=self.w0, ts=self.ts,
+                               periods=self.effective_periods(varY, nl, width))
+            # so that lptv.identify judges a fit of all M of them by lack_of_fit
+            fd.distortion, fd.realisation = self, m
+            out.append(fd)
         return out
 
     def effective_periods(self, varY, nl, width: int = 5) -> int:
@@ -177,6 +253,118 @@ class DistortionResult:
         if nu.size == 0:
             return P
         return max(P, int(np.floor(1.0 + float(np.median(nu)) / 2.0)))
+
+    def lack_of_fit(self, model, lines=None) -> LackOfFit:
+        """Judge a parametric model of the best linear approximation (a fit of
+        :meth:`experiments`) against the per-line regression across the realisations.
+
+        The verdict of section 7 reads a fit's residues as independent across lines with the
+        variances the data carry; the nonlinear distortion is neither (it is correlated across
+        neighbouring lines, and where it enters before the dynamics it is shaped by them), so
+        that verdict rejects good BLA fits. This test makes no assumption on how the
+        distortion is correlated across lines (METHOD.md section 16, "Judging the parametric
+        BLA"). :func:`lptv.identify` uses it for the verdict of a fit of these experiments
+        (:attr:`lptv.IdentificationResult.lack_of_fit`).
+
+        Parameters
+        ----------
+        model : lptv.Model or lptv.IdentificationResult
+            The model (its w0 and ts must be the data's).
+        lines : sequence of int, optional
+            The output lines to judge (default: every line with at least one regressor and one
+            residual degree of freedom); lines without them are left out.
+
+        Returns
+        -------
+        LackOfFit
+            ``rejects`` at 1 %; with M = 4 realisations (24 permutations) it cannot.
+
+        Examples
+        --------
+        >>> import numpy as np, lptv
+        >>> from lptv.examples import noisy_periods, paper_model
+        >>> m = paper_model()
+        >>> u, y = [], []
+        >>> for r in range(6):
+        ...     ms = lptv.multisine(range(10, 241, 10), 2048, amplitudes=np.sqrt(2 / 24), seed=r)
+        ...     y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 2048)
+        ...     a, b = noisy_periods(ms.signal, y0 + 0.02 * y0 ** 3, 4, 50, 30, seed=100 + r)
+        ...     u.append(a); y.append(b)
+        >>> d = lptv.distortion(np.array(u), np.array(y), w0=m.w0)
+        >>> rows = [range(1, 244)] * 6
+        >>> good = lptv.identify(d.experiments(), na=2, nb=1, ka=3, kb=3, lines=rows, method="sml")
+        >>> poor = lptv.identify(d.experiments(), na=2, nb=1, ka=2, kb=2, lines=rows, method="sml")
+        >>> d.lack_of_fit(good).rejects, d.lack_of_fit(poor).rejects
+        (False, True)
+        """
+        from scipy import stats
+
+        from .fds import simulate
+        from .model import Model
+
+        m = getattr(model, "model", model)
+        if not isinstance(m, Model):
+            raise ValueError(f"model must be an lptv.Model or an IdentificationResult, got {type(model).__name__}")
+        if not np.isclose(m.w0, self.w0, rtol=1e-9, atol=0.0):
+            raise ValueError(f"model: its w0 = {m.w0:g} differs from the data's {self.w0:g}")
+        if (m.ts is None) != (self.ts is None) or (m.ts is not None and not np.isclose(m.ts, self.ts, rtol=1e-9)):
+            raise ValueError(f"model: its ts = {m.ts} differs from the data's {self.ts}")
+        if not self.spectra:
+            raise ValueError("this DistortionResult holds no spectra (made without them): nothing to judge")
+        M = self.realisations
+        U = np.array([s[0] for s in self.spectra]).T      # (L + 1, M)
+        Y = np.array([s[1] for s in self.spectra]).T
+        Uex = np.zeros_like(U)
+        Uex[self.excited] = U[self.excited]
+        R = Y - simulate(m, Uex, warn_unstable=False)     # the residual rows of the model
+        wanted = self.lines if lines is None else np.unique(np.asarray(lines, dtype=int).ravel())
+        bad = wanted[(wanted < 1) | (wanted > self.lines.size)]
+        if bad.size:
+            raise ValueError(f"lines: line {int(bad[0])} is not an output line 1..{self.lines.size} of the data")
+        ex = np.asarray(self.excited, dtype=int)
+        judged, ranks, projections = [], [], []
+        for j in wanted:
+            cs = np.concatenate([ex[np.abs(j - ex) <= self.branches], -ex[ex + j <= self.branches]])
+            if cs.size == 0 or M - cs.size < 1:
+                continue
+            X = np.where(cs > 0, U[np.abs(cs)].T, np.conj(U[np.abs(cs)].T))    # (M, q)
+            W, sv, _ = np.linalg.svd(X, full_matrices=False)
+            rank = int(np.sum(sv > np.finfo(float).eps * max(X.shape) * (sv[0] if sv.size else 0.0)))
+            if rank == 0 or M - rank < 1:
+                continue
+            judged.append(int(j))
+            ranks.append(rank)
+            projections.append(W[:, :rank])
+        if not judged:
+            raise ValueError("lines: no line with a regressor and a residual degree of freedom to judge")
+        judged, ranks = np.array(judged), np.array(ranks)
+        Rl = R[judged]                                      # (n, M)
+        total = np.sum(np.abs(Rl) ** 2, axis=1)
+        perms = _permutations(M)
+
+        def lof_of(block):                                 # (n, len(block)): the lack of fit per permutation
+            Rp = Rl[:, block]                              # (n, b, M)
+            out = np.empty((judged.size, block.shape[0]))
+            for i, Wq in enumerate(projections):
+                c = Rp[i] @ np.conj(Wq)                    # coordinates on the regressors' span
+                out[i] = np.sum(np.abs(c) ** 2, axis=1)
+            return out
+
+        q, rdof = ranks[:, None], (M - ranks)[:, None]
+        sums = []
+        for k in range(0, perms.shape[0], 500):
+            lof = lof_of(perms[k:k + 500])
+            pure = np.maximum(total[:, None] - lof, np.finfo(float).tiny)
+            F = (lof / q) / (pure / rdof)
+            p = stats.f.sf(F, 2 * q, 2 * rdof)
+            if k == 0:
+                F0, p0 = F[:, 0], p[:, 0]
+            sums.append(stats.norm.isf(np.clip(p, 1e-300, 1.0)).sum(axis=0))
+        sums = np.concatenate(sums)
+        p_perm = float(np.mean(sums >= sums[0] - 1e-12 * max(1.0, abs(sums[0]))))
+        return LackOfFit(lines=judged, regressors=ranks, F=F0, p_lines=p0,
+                         statistic=float(sums[0] / np.sqrt(judged.size)), p_value=p_perm,
+                         permutations=int(perms.shape[0]), realisations=M)
 
     def summary(self) -> str:
         ok = np.isfinite(self.p_value)

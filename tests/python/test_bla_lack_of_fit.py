@@ -1,0 +1,159 @@
+"""The verdict of a fit of the best linear approximation (DistortionResult.lack_of_fit, METHOD.md
+section 16, "Judging the parametric BLA"): each line's lack of fit against the per-line
+regression across the realisations, referred to the realisations' permutations.
+
+A Hammerstein system (a cubic actuator x = u + c u^3 before the third-order LPTV system) has a
+best linear approximation inside the fitted class (the LPTV system times the actuator's linear
+gain); its distortion enters before the dynamics, where the verdict of section 7 (residues
+independent across lines, variances as the data carry them) rejects every such fit. The
+lack-of-fit test keeps the right structure and rejects a missing harmonic and a missing order."""
+import warnings
+
+import numpy as np
+import pytest
+from scipy import stats
+
+import lptv
+from lptv.examples import (THIRD_ORDER_EXCITED, THIRD_ORDER_ID_LINES, THIRD_ORDER_N, THIRD_ORDER_STRUCTURE,
+                           noisy_periods, third_order_model)
+
+
+def _hammerstein(seed, M=6, P=8, c=0.05):
+    m = third_order_model()
+    rng = np.random.default_rng([seed, 77])
+    N = THIRD_ORDER_N
+    u, y = [], []
+    for _ in range(M):
+        ms = lptv.multisine(THIRD_ORDER_EXCITED, N, amplitudes=np.sqrt(2 / THIRD_ORDER_EXCITED.size), seed=rng)
+        x = ms.signal + c * ms.signal ** 3
+        y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(x) / N), N)
+        a, b = noisy_periods(ms.signal, y0, P, 40.0, 25.0, seed=rng)
+        u.append(a)
+        y.append(b)
+    return m, lptv.distortion(np.array(u), np.array(y), w0=m.w0)
+
+
+def _fit(d, structure):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return lptv.identify(d.experiments(), lines=[THIRD_ORDER_ID_LINES] * d.realisations, method="sml",
+                             **structure)
+
+
+@pytest.fixture(scope="module")
+def cases():
+    return [_hammerstein(seed) for seed in (0, 1, 2)]
+
+
+def test_each_line_is_the_nested_regression_f_test(cases):
+    """Line by line, F is the textbook test of the model's prediction against the least-squares
+    regression on the line's regressors, computed here with numpy.linalg.lstsq."""
+    m, d = cases[0]
+    res = _fit(d, THIRD_ORDER_STRUCTURE)
+    lof = d.lack_of_fit(res)
+    U = np.array([s[0] for s in d.spectra]).T
+    Y = np.array([s[1] for s in d.spectra]).T
+    Uex = np.zeros_like(U)
+    Uex[d.excited] = U[d.excited]
+    R = Y - lptv.simulate(res.model, Uex, warn_unstable=False)
+    M = d.realisations
+    for i in range(0, lof.lines.size, 17):
+        j = int(lof.lines[i])
+        cs = [c for c in d.excited if abs(j - c) <= d.branches] + [-c for c in d.excited if c + j <= d.branches]
+        X = np.column_stack([U[c] if c > 0 else np.conj(U[-c]) for c in cs])
+        beta, *_ = np.linalg.lstsq(X, R[j], rcond=None)
+        lack = np.sum(np.abs(X @ beta) ** 2)
+        pure = np.sum(np.abs(R[j] - X @ beta) ** 2)
+        q = len(cs)
+        F = (lack / q) / (pure / (M - q))
+        assert lof.regressors[i] == q
+        assert lof.F[i] == pytest.approx(F, rel=1e-9)
+        assert lof.p_lines[i] == pytest.approx(stats.f.sf(F, 2 * q, 2 * (M - q)), rel=1e-9)
+    assert lof.permutations == 720 and 1 / 720 <= lof.p_value <= 1
+
+
+def test_the_right_structure_is_kept_where_the_residue_tests_reject_it(cases):
+    for m, d in cases:
+        res = _fit(d, THIRD_ORDER_STRUCTURE)
+        assert res.lack_of_fit is not None
+        assert not res.lack_of_fit.rejects, res.lack_of_fit
+        assert res.model_ok, res.verdict
+        assert res.verdict.startswith("the model is consistent with the best linear approximation")
+        # what the verdict said before: the residue tests of section 7 reject it
+        assert any(t.rejects for t in res.residue_tests.tests)
+
+
+@pytest.mark.parametrize("structure", [dict(na=3, nb=1, ka=[1, 1, 0, 0], kb=[2, 0]),   # a0's harmonic 2 left out
+                                       dict(na=2, nb=1, ka=[2, 1, 0], kb=[2, 0])])     # one order too few
+def test_a_missing_harmonic_and_a_missing_order_are_rejected(cases, structure):
+    for m, d in cases:
+        res = _fit(d, structure)
+        assert res.lack_of_fit.rejects
+        assert not res.model_ok
+        assert "best linear approximation" in res.verdict and res.verdict.startswith("MODEL ERRORS")
+
+
+def test_the_true_best_linear_approximation_passes(cases):
+    """The exact BLA (the LPTV system with b scaled by the actuator's linear gain, measured from
+    the cubic over 200 realisations of the multisine) is not rejected either."""
+    rng = np.random.default_rng(3)
+    num = den = 0.0
+    for _ in range(200):
+        ms = lptv.multisine(THIRD_ORDER_EXCITED, THIRD_ORDER_N, amplitudes=np.sqrt(2 / THIRD_ORDER_EXCITED.size),
+                            seed=rng)
+        X = np.fft.rfft(ms.signal + 0.05 * ms.signal ** 3) / THIRD_ORDER_N
+        num += np.sum(X[THIRD_ORDER_EXCITED] * np.conj(ms.spectrum[THIRD_ORDER_EXCITED]))
+        den += np.sum(np.abs(ms.spectrum[THIRD_ORDER_EXCITED]) ** 2)
+    g = float(np.real(num / den))
+    assert 1.1 < g < 1.2
+    for m, d in cases:
+        bla = lptv.Model(np.array(m.a), np.array(m.b) * g, w0=m.w0)
+        assert not d.lack_of_fit(bla, lines=THIRD_ORDER_ID_LINES).rejects
+
+
+def test_only_a_fit_of_all_the_realisations_is_judged_so(cases):
+    m, d = cases[0]
+    exps = d.experiments()
+    assert all(e.distortion is d and e.realisation == k for k, e in enumerate(exps))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        five = lptv.identify(exps[:5], lines=[THIRD_ORDER_ID_LINES] * 5, method="sml", **THIRD_ORDER_STRUCTURE)
+        plain = lptv.identify([lptv.FrequencyData(e.U, e.Y, e.varU, e.varY, e.covYU, w0=e.w0, periods=e.periods)
+                               for e in exps], lines=[THIRD_ORDER_ID_LINES] * 6, method="sml",
+                              **THIRD_ORDER_STRUCTURE)
+    assert five.lack_of_fit is None and plain.lack_of_fit is None
+
+
+def test_four_realisations_cannot_reject_and_the_verdict_says_so():
+    m, d = _hammerstein(5, M=4)
+    res = _fit(d, dict(na=2, nb=1, ka=[2, 1, 0], kb=[2, 0]))     # even a missing order
+    lof = res.lack_of_fit
+    assert lof.permutations == 24 and not lof.can_reject and not lof.rejects
+    assert res.verdict.startswith("NOT DETERMINED") and "4 realisations cannot show a lack of fit" in res.verdict
+
+
+def test_more_than_six_realisations_draw_their_permutations_reproducibly():
+    m, d = _hammerstein(6, M=7, P=4)
+    res = _fit(d, THIRD_ORDER_STRUCTURE)
+    a, b = d.lack_of_fit(res), d.lack_of_fit(res.model)
+    assert a.permutations == 2000 and a.p_value == b.p_value
+
+
+def test_bad_arguments_name_themselves(cases):
+    m, d = cases[0]
+    with pytest.raises(ValueError, match="model must be an lptv.Model"):
+        d.lack_of_fit("a model")
+    with pytest.raises(ValueError, match="w0"):
+        d.lack_of_fit(lptv.Model(np.array(m.a), np.array(m.b), w0=2 * m.w0))
+    with pytest.raises(ValueError, match="ts"):
+        d.lack_of_fit(lptv.Model(np.array(m.a), np.array(m.b), w0=m.w0, ts=0.1))
+    with pytest.raises(ValueError, match="lines: line 100000"):
+        d.lack_of_fit(m, lines=[3, 100000])
+
+
+def test_docstring_examples_run():
+    import doctest
+    import sys
+
+    result = doctest.testmod(sys.modules["lptv.distortion"], optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
