@@ -48,16 +48,50 @@ SYSTEMS = {
 }
 
 
+def actuator_gain(system, c, n=400):
+    """Hammerstein: the linear gain of x = u + c u^3 for the flat random-phase multisine, over n
+    realisations (the exact BLA is the LPTV system with b times it)."""
+    _, excited, N, *_ = SYSTEMS[system]
+    rng = np.random.default_rng(12345)
+    num = den = 0.0
+    for _ in range(n):
+        ms = lptv.multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
+        X = np.fft.rfft(ms.signal + c * ms.signal ** 3) / N
+        num += np.sum(X[excited] * np.conj(ms.spectrum[excited]))
+        den += np.sum(np.abs(ms.spectrum[excited]) ** 2)
+    return float(np.real(num / den))
+
+
+def exact_bla_eta(system, g, names):
+    """The exact BLA's parameters (Hammerstein) in the fit's parameter names."""
+    m = SYSTEMS[system][0]()
+    a, b = np.array(m.a), np.array(m.b) * g
+    out = []
+    for name in names:
+        c, rest = name[0], name[1:]
+        n, part = rest.split(".")
+        arr = a if c == "a" else b
+        K = (arr.shape[1] - 1) // 2
+        k = int(part[2:])
+        z = arr[int(n), K + k] if k <= K else 0.0
+        out.append(np.real(z) if part.startswith("re") else np.imag(z))
+    return np.array(out)
+
+
 def one(args):
-    run, c, P, M, system = args
+    run, c, P, M, system, kind = args
     make, excited, N, rows, structure, noise = SYSTEMS[system]
     rng = np.random.default_rng([run, 77])
     m = make()
     u, y = [], []
     for _ in range(M):
         ms = lptv.multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
-        y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), N)
-        a, b = ex.noisy_periods(ms.signal, y0 + c * y0**3, P, seed=rng, **noise)
+        if kind == "hammerstein":   # the cubic before the LPTV system (an actuator)
+            y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + c * ms.signal ** 3) / N), N)
+        else:                       # after it (Wiener)
+            y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), N)
+            y0 = y0 + c * y0 ** 3
+        a, b = ex.noisy_periods(ms.signal, y0, P, seed=rng, **noise)
         u.append(a)
         y.append(b)
     u, y = np.array(u), np.array(y)
@@ -82,11 +116,14 @@ def main():
     ap.add_argument("--realisations", type=int, default=6, help="M (at least 4 for the jackknife)")
     ap.add_argument("--system", default="paper", choices=tuple(SYSTEMS))
     ap.add_argument("--save", metavar="NPZ", help="keep every run's estimates and stds in this file")
+    ap.add_argument("--kind", default="wiener", choices=("wiener", "hammerstein"),
+                    help="the cubic after the LPTV system (y + c y^3) or before it (x = u + c u^3: the exact BLA "
+                         "is then known, and the coverage around it is printed too)")
     args = ap.parse_args()
     M = args.realisations
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as pool:
-        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system) for r in range(args.runs)],
+        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind) for r in range(args.runs)],
                             chunksize=4))
     n = len(out[0][0])
     bad = [r for r, o in enumerate(out) if any(x is None or np.shape(x) != (n,) for x in o[:5])]
@@ -104,7 +141,12 @@ def main():
     names = np.array(out[0][7])[free]
     target = eb.mean(0)[free]
     z95 = 1.959964
-    print(f"# {R} runs in {time.time() - t0:.0f} s; system {args.system}, cubic c = {args.cubic}, M = {M}, "
+    truth = None
+    if args.kind == "hammerstein":
+        g = actuator_gain(args.system, args.cubic)
+        truth = exact_bla_eta(args.system, g, out[0][7])[free]
+        print(f"# Hammerstein: the actuator's linear gain g = {g:.5f}; the exact BLA is the LPTV system with b times g")
+    print(f"# {R} runs in {time.time() - t0:.0f} s; system {args.system} ({args.kind}), cubic c = {args.cubic}, M = {M}, "
           f"P = {args.periods}; distortion detected in {100 * det.mean():.0f} % of the runs; effective periods "
           f"{pe.min()}-{pe.max()}")
     print(f"{'parameter':>10} {'target':>10} {'se(target)':>10} {'analytic var/rep':>16} {'cover':>6} "
@@ -133,6 +175,14 @@ def main():
     print(f"  realisations: {pct(3)}, var/rep median {np.median(a[:, 2]):.2f} (range {a[:, 2].min():.2f}-"
           f"{a[:, 2].max():.2f}; (M-3)/(M-1) = {(M - 3) / (M - 1):.2f} when right)")
     print(f"  noise only:   {pct(5)}, var/rep median {np.median(a[:, 4]):.2f}")
+    if truth is not None:   # the intervals around the exact BLA, and the estimate's bias against it
+        ej = np.abs(eb[:, free] - truth)
+        cov_t = np.mean(ej <= z95 * sj[:, free], axis=0)
+        bias = np.abs(eb[:, free].mean(0) - truth) / eb[:, free].std(0, ddof=1)
+        worst = names[np.argmax(bias)]
+        print(f"  around the exact BLA: realisations {100 * cov_t.mean():.1f} % (per parameter {100 * cov_t.min():.1f}-"
+              f"{100 * cov_t.max():.1f} %); the SML estimate's |bias| / std median {np.median(bias):.2f}, largest "
+              f"{bias.max():.2f} ({worst}; the standard error of a mean is {1 / np.sqrt(R):.3f} std)")
     if huge.any():
         print(f"  realisations: runs with a std above 10 times its median, per parameter: {huge.min()}-{huge.max()} "
               "(a leave-one-out refit far from the others; var/rep is then dominated by them)")
