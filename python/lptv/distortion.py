@@ -33,7 +33,7 @@ from typing import Optional
 import numpy as np
 
 from . import _core
-from ._validate import as_int, as_positive_float
+from ._validate import as_int, as_lines, as_positive_float
 from .data import FrequencyData
 
 ALPHA = 0.01
@@ -306,9 +306,9 @@ class DistortionResult:
         if not isinstance(m, Model):
             raise ValueError(f"model must be an lptv.Model or an IdentificationResult, got {type(model).__name__}")
         if not np.isclose(m.w0, self.w0, rtol=1e-9, atol=0.0):
-            raise ValueError(f"model: its w0 = {m.w0:g} differs from the data's {self.w0:g}")
+            raise ValueError(f"model: its w0 = {m.w0:g} is not the data's {self.w0:g}")
         if (m.ts is None) != (self.ts is None) or (m.ts is not None and not np.isclose(m.ts, self.ts, rtol=1e-9)):
-            raise ValueError(f"model: its ts = {m.ts} differs from the data's {self.ts}")
+            raise ValueError(f"model: its ts = {m.ts} is not the data's {self.ts}")
         if not self.spectra:
             raise ValueError("this DistortionResult holds no spectra (made without them): nothing to judge")
         M = self.realisations
@@ -317,7 +317,7 @@ class DistortionResult:
         Uex = np.zeros_like(U)
         Uex[self.excited] = U[self.excited]
         R = Y - simulate(m, Uex, warn_unstable=False)     # the residual rows of the model
-        wanted = self.lines if lines is None else np.unique(np.asarray(lines, dtype=int).ravel())
+        wanted = self.lines if lines is None else np.unique(np.asarray(as_lines(lines, "lines", minimum=1)))
         bad = wanted[(wanted < 1) | (wanted > self.lines.size)]
         if bad.size:
             raise ValueError(f"lines: line {int(bad[0])} is not an output line 1..{self.lines.size} of the data")
