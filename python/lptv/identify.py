@@ -433,6 +433,12 @@ class IdentificationResult:
             f"normalised residue above 0 dB: {100 * self.fraction_above_0db:.1f} % "
             f"(expected {100 * self.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %): {verdict}",
         ]
+        lof = self.lack_of_fit
+        if lof is not None:
+            lines[-1] += " (not the verdict's test for these realisations: the line below is)"
+            lines.append(f"lack of fit against the per-line regression across the {lof.realisations} realisations: "
+                         f"z = {lof.statistic:.2f}, permutation p = {lof.p_value:.2g} ({lof.permutations} permutations, "
+                         f"{lof.lines.size} lines; the largest on lines {', '.join(str(int(j)) for j in lof.worst())})")
         from .parameters import format_parameter_table
 
         lines.append("parameters" + (" (no covariance with this method)" if self.covariance is None else "")
