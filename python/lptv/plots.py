@@ -7,6 +7,8 @@ matplotlib's settings.
 """
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 
@@ -204,6 +206,59 @@ def normalized_residue(lines, r, *, w0=None, ax=None, fraction=None, expected=No
         ax.set_title(", ".join(title))
     ax.set_xlabel(xlabel)
     ax.set_ylabel("normalised residue (dB)")
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
+def lack_of_fit(lof, *, w0: Optional[float] = None, hz: bool = False, ax=None):
+    """Where a model of the best linear approximation departs from the per-line regression
+    across the realisations (a :class:`lptv.LackOfFit`, ``res.lack_of_fit``): each judged line's
+    -log10 of its F test's p-value, the 5 % and 1 % lines of one line's test, the three worst
+    lines marked. The verdict itself is the permutation test of all lines together (in the
+    title); single lines above the 1 % line are expected in about 1 % of the lines.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.examples import noisy_periods, paper_model
+    >>> m = paper_model()
+    >>> u, y = [], []
+    >>> for r in range(6):
+    ...     ms = lptv.multisine(range(10, 241, 10), 2048, amplitudes=np.sqrt(2 / 24), seed=r)
+    ...     y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 2048)
+    ...     a, b = noisy_periods(ms.signal, y0 + 0.02 * y0 ** 3, 4, 50, 30, seed=100 + r)
+    ...     u.append(a); y.append(b)
+    >>> d = lptv.distortion(np.array(u), np.array(y), w0=m.w0)
+    >>> res = lptv.identify(d.experiments(), na=2, nb=1, ka=3, kb=3, lines=[range(1, 244)] * 6, method="sml")
+    >>> ax = lptv.plots.lack_of_fit(res.lack_of_fit, w0=m.w0)
+    >>> ax.get_ylabel()
+    '-log10 p of the line'
+    """
+    from .distortion import LackOfFit
+    from ._validate import as_bool, as_positive_float
+
+    if not isinstance(lof, LackOfFit):
+        raise ValueError(f"lof must be an lptv.LackOfFit (res.lack_of_fit or d.lack_of_fit(model)), "
+                         f"got {type(lof).__name__}")
+    hz = as_bool(hz, "hz")
+    if w0 is not None:
+        w0 = as_positive_float(w0, "w0")
+    ax = _axes(ax)
+    x = lof.lines * (1.0 if w0 is None else w0 / (2 * np.pi if hz else 1.0))
+    y = -np.log10(np.clip(lof.p_lines, 1e-300, 1.0))
+    ax.plot(x, y, ".", ms=4, color="C0", label="per line: F(2 q, 2 (M - q)) test")
+    for level, style in ((0.05, ":"), (0.01, "--")):
+        ax.axhline(-np.log10(level), color="0.4", ls=style, lw=1, label=f"one line at {100 * level:g} %")
+    worst = np.argsort(lof.p_lines, kind="stable")[:3]
+    for i in worst:
+        ax.annotate(str(int(lof.lines[i])), (x[i], y[i]), textcoords="offset points", xytext=(3, 3),
+                    fontsize="x-small")
+    ax.set_xlabel("line" if w0 is None else ("frequency (Hz)" if hz else "angular frequency (rad/s)"))
+    ax.set_ylabel("-log10 p of the line")
+    ax.set_title(f"lack of fit against the {lof.realisations} realisations: z = {lof.statistic:.2f}, permutation "
+                 f"p = {lof.p_value:.2g} ({'rejected' if lof.rejects else 'not rejected'} at "
+                 f"{100 * lof.alpha:g} %)", fontsize="medium")
+    ax.legend(fontsize="small")
     ax.grid(True, alpha=0.3)
     return ax
 

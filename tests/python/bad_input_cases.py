@@ -878,6 +878,7 @@ def python_cases():
              lambda: _plots().frozen_poles_zeros([0.0, 1.0], poles_est=np.zeros((3, 2))), match=names("poles_est")),
         Case("plots.htf_branches-est-str", "type", lambda: _plots().htf_branches("abc"), match=names("est")),
         Case("plots.compare-cmp-str", "type", lambda: _plots().compare("abc"), match=names("cmp")),
+        Case("plots.lack_of_fit-lof-str", "type", lambda: _plots().lack_of_fit("abc"), match=names("lof")),
         Case("plots.output_spectrum-w0-nan", "nan/inf", lambda: _plots().output_spectrum([1, 2], [1.0, 1.0], w0=NaN),
              match=names("w0")),
     ]

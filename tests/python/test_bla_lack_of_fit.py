@@ -157,3 +157,20 @@ def test_docstring_examples_run():
 
     result = doctest.testmod(sys.modules["lptv.distortion"], optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_the_figure_of_the_lines_runs_its_example(cases):
+    import doctest
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import lptv.plots
+
+    finder = doctest.DocTestFinder()
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE)
+    for t in finder.find(lptv.plots.lack_of_fit, "lack_of_fit", globs={}):
+        runner.run(t)
+    assert runner.tries > 0 and runner.failures == 0
+    m, d = cases[0]
+    ax = lptv.plots.lack_of_fit(d.lack_of_fit(_fit(d, THIRD_ORDER_STRUCTURE)), w0=m.w0, hz=True)
+    assert ax.get_xlabel() == "frequency (Hz)" and "not rejected" in ax.get_title()

@@ -53,6 +53,9 @@ def test_identify_file_of_realisations_matches_the_library(tmp_path, seed, capsy
     assert np.allclose(model.b, ref.model.b, rtol=1e-9, atol=1e-12)
     html = (out / "report.html").read_text()
     assert "distortion.png" in html and (out / "distortion.png").stat().st_size > 1000
+    # the verdict of a fit of the realisations: their lack of fit (4 realisations cannot reach 1 %)
+    assert "lack_of_fit.png" in html and (out / "lack_of_fit.png").stat().st_size > 1000
+    assert "4 realisations cannot show a lack of fit" in s["verdict"]
 
 
 def test_identify_file_of_realisations_without_distortion(tmp_path, capsys):

@@ -162,6 +162,13 @@ def _report(src, meas, dist, res, summary) -> Report:
            "times (M-1)/(M-3)), which holds whatever the distortion's correlation across lines."
            if summary.get("covariance") == "realisations" else ""))
     rep.paragraph("Verdict: " + res.verdict + ".")
+    if res.lack_of_fit is not None:
+        rep.figure(plots.lack_of_fit(res.lack_of_fit, w0=model.w0).figure, "lack_of_fit.png",
+                   "The verdict's test: on each judged output line the model's prediction against the "
+                   "regression of that line across the realisations (its F test's -log10 p; about 1 % of "
+                   "the lines above the 1 % line when the model is the best linear approximation). The "
+                   "decision is the permutation test of all lines together, in the title (METHOD.md "
+                   "section 16).")
     rep.preformatted(res.summary())
     rep.figure(plots.bode(res), "bode.png",
                "Each realisation's measured FRF Y/U on its excited lines (+-2 std from its periods) and the "
