@@ -255,8 +255,8 @@ def lack_of_fit(lof, *, w0: Optional[float] = None, hz: bool = False, ax=None):
                     fontsize="x-small")
     ax.set_xlabel("line" if w0 is None else ("frequency (Hz)" if hz else "angular frequency (rad/s)"))
     ax.set_ylabel("-log10 p of the line")
-    ax.set_title(f"lack of fit against the {lof.realisations} realisations: z = {lof.statistic:.2f}, permutation "
-                 f"p = {lof.p_value:.2g} ({'rejected' if lof.rejects else 'not rejected'} at "
+    ax.set_title(f"lack of fit against the {lof.realisations} realisations: z = {lof.statistic:.2f},\n"
+                 f"permutation p = {lof.p_value:.2g} ({'rejected' if lof.rejects else 'not rejected'} at "
                  f"{100 * lof.alpha:g} %)", fontsize="medium")
     ax.legend(fontsize="small")
     ax.grid(True, alpha=0.3)
