@@ -27,6 +27,7 @@ the F tests and the overall statistic (SciPy) after it, here.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -91,16 +92,14 @@ class LackOfFit:
         return self.lines[np.argsort(self.p_lines, kind="stable")[:k]]
 
     def sentence(self) -> str:
-        side = "departs from" if self.statistic > 0 else "stays closer than its noise to"
-        return (f"the model {side} the best linear approximation that the {self.realisations} realisations give "
+        """The verdict's sentence when the test rejects (it is one-sided: a lack of fit)."""
+        return (f"the model departs from the best linear approximation that the {self.realisations} realisations give "
                 f"line by line (lack of fit on {self.lines.size} lines: z = {self.statistic:.2f}, permutation "
                 f"p = {self.p_value:.2g} <= {self.alpha:g}; largest on lines "
                 f"{', '.join(str(int(j)) for j in self.worst())})")
 
 
 def _permutations(M: int) -> np.ndarray:
-    import math
-
     if math.factorial(M) <= LOF_ALL_PERMUTATIONS:
         return np.array(list(itertools.permutations(range(M))), dtype=int)
     rng = np.random.default_rng(20261126 + M)

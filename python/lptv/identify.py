@@ -332,7 +332,8 @@ class IdentificationResult:
     @property
     def model_errors(self) -> Tuple[str, ...]:
         """The signs of a model error, each as a sentence (empty when none): a residue test of
-        :attr:`residue_tests` that rejects (or, without them, residues outside the predicted band
+        :attr:`residue_tests` that rejects (for a fit of a DistortionResult's realisations
+        :attr:`lack_of_fit` instead; without either, residues outside the predicted band
         on the excited lines), a cost far above 1, a prediction error far above the noise. Any
         one rejects the model, whatever the fraction on all rows says."""
         out = []
@@ -372,7 +373,8 @@ class IdentificationResult:
         the noise-weighted problem are within the Marchenko-Pastur band of a noise-only
         subspace, i.e. a second parameter direction explains the data as well as the estimate;
         for LS and TLS the GTLS problem on the same lines is tested). The verdict then does not
-        call the model consistent."""
+        call the model consistent. A fit of a DistortionResult's M = 4 realisations is not
+        determined either: its lack-of-fit test (:attr:`lack_of_fit`) cannot reach 1 %."""
         lof = self.lack_of_fit
         if lof is not None and not lof.can_reject:
             return (f"{lof.realisations} realisations cannot show a lack of fit at {100 * lof.alpha:g} % "
