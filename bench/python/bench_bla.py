@@ -27,6 +27,7 @@ M - 1 degrees of freedom) and the coverage that of the t interval, 94.7 % at M =
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import time
 import warnings
@@ -79,8 +80,9 @@ def exact_bla_eta(system, g, names):
 
 
 def one(args):
-    run, c, P, M, system, kind = args
+    run, c, P, M, system, kind, fitted = args
     make, excited, N, rows, structure, noise = SYSTEMS[system]
+    structure = fitted or structure
     rng = np.random.default_rng([run, 77])
     m = make()
     u, y = [], []
@@ -116,6 +118,9 @@ def main():
     ap.add_argument("--realisations", type=int, default=6, help="M (at least 4 for the jackknife)")
     ap.add_argument("--system", default="paper", choices=tuple(SYSTEMS))
     ap.add_argument("--save", metavar="NPZ", help="keep every run's estimates and stds in this file")
+    ap.add_argument("--structure", type=json.loads, default=None,
+                    help='the fitted structure as JSON, e.g. \'{"na": 3, "nb": 1, "ka": [2, 1, 0, 1], "kb": [3, 0]}\' '
+                         "(default: the system's own)")
     ap.add_argument("--kind", default="wiener", choices=("wiener", "hammerstein"),
                     help="the cubic after the LPTV system (y + c y^3) or before it (x = u + c u^3: the exact BLA "
                          "is then known, and the coverage around it is printed too)")
@@ -123,7 +128,7 @@ def main():
     M = args.realisations
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as pool:
-        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind) for r in range(args.runs)],
+        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind, args.structure) for r in range(args.runs)],
                             chunksize=4))
     n = len(out[0][0])
     bad = [r for r, o in enumerate(out) if any(x is None or np.shape(x) != (n,) for x in o[:5])]
@@ -146,6 +151,8 @@ def main():
         g = actuator_gain(args.system, args.cubic)
         truth = exact_bla_eta(args.system, g, out[0][7])[free]
         print(f"# Hammerstein: the actuator's linear gain g = {g:.5f}; the exact BLA is the LPTV system with b times g")
+    if args.structure:
+        print(f"# fitted structure {args.structure}")
     print(f"# {R} runs in {time.time() - t0:.0f} s; system {args.system} ({args.kind}), cubic c = {args.cubic}, M = {M}, "
           f"P = {args.periods}; distortion detected in {100 * det.mean():.0f} % of the runs; effective periods "
           f"{pe.min()}-{pe.max()}")
