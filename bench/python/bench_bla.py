@@ -80,7 +80,7 @@ def exact_bla_eta(system, g, names):
 
 
 def one(args):
-    run, c, P, M, system, kind, fitted = args
+    run, c, P, M, system, kind, fitted, referred = args
     make, excited, N, rows, structure, noise = SYSTEMS[system]
     structure = fitted or structure
     rng = np.random.default_rng([run, 77])
@@ -102,6 +102,9 @@ def one(args):
         warnings.simplefilter("ignore")
         d = lptv.distortion(u, y, w0=m.w0, ts=m.ts)
         exps = d.experiments()
+        if referred == "input":   # the level referred to the input through a first (output-referred) fit
+            first = lptv.identify(exps, lines=rows, method="sml", **structure)
+            exps = d.experiments(referred="input", model=first)
         bla = lptv.identify(exps, lines=rows, method="sml", **structure)
         jk = lptv.identify(exps, lines=rows, method="sml", covariance="realisations", **structure)
         plain = lptv.identify([(u[i], y[i]) for i in range(M)], w0=m.w0, ts=m.ts, lines=rows, method="sml", **structure)
@@ -121,6 +124,9 @@ def main():
     ap.add_argument("--structure", type=json.loads, default=None,
                     help='the fitted structure as JSON, e.g. \'{"na": 3, "nb": 1, "ka": [2, 1, 0, 1], "kb": [3, 0]}\' '
                          "(default: the system's own)")
+    ap.add_argument("--referred", default="output", choices=("output", "input"),
+                    help="DistortionResult.experiments(referred=...): the nonlinear level on the output variances, or "
+                         "referred to the input through a first fit (for a nonlinearity before the dynamics)")
     ap.add_argument("--kind", default="wiener", choices=("wiener", "hammerstein"),
                     help="the cubic after the LPTV system (y + c y^3) or before it (x = u + c u^3: the exact BLA "
                          "is then known, and the coverage around it is printed too)")
@@ -128,7 +134,8 @@ def main():
     M = args.realisations
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as pool:
-        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind, args.structure) for r in range(args.runs)],
+        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind, args.structure, args.referred)
+                             for r in range(args.runs)],
                             chunksize=4))
     n = len(out[0][0])
     bad = [r for r, o in enumerate(out) if any(x is None or np.shape(x) != (n,) for x in o[:5])]
@@ -153,6 +160,7 @@ def main():
         print(f"# Hammerstein: the actuator's linear gain g = {g:.5f}; the exact BLA is the LPTV system with b times g")
     if args.structure:
         print(f"# fitted structure {args.structure}")
+    print(f"# the nonlinear level referred to the {args.referred}")
     print(f"# {R} runs in {time.time() - t0:.0f} s; system {args.system} ({args.kind}), cubic c = {args.cubic}, M = {M}, "
           f"P = {args.periods}; distortion detected in {100 * det.mean():.0f} % of the runs; effective periods "
           f"{pe.min()}-{pe.max()}")
