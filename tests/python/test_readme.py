@@ -106,3 +106,13 @@ def test_readme_continuous_record_example_runs(tmp_path, monkeypatch):
     res = ns["res"]
     assert res.periods == 2 and res.converged and 0.8 < res.cost_ratio < 1.2
     assert res.model.ts is None and res.transient.size == 5
+
+
+def test_readme_input_referred_example_runs(tmp_path, monkeypatch):
+    """The block that refers an actuator's distortion to the input continues the rig's block."""
+    ns = run_block("lptv.distortion(", tmp_path, monkeypatch)
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S) if 'referred="input"' in b]
+    assert len(blocks) == 1
+    exec(compile(blocks[0], "README.md", "exec"), ns)
+    lof = ns["bla_in"].lack_of_fit
+    assert lof is not None and lof.realisations == 6 and ns["bla_in"].covariance is not None
