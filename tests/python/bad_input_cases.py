@@ -970,6 +970,7 @@ def cli_cases():
     add("identify-method-bogus", ok + ("--method", "ml"), "--method")
     add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
     add("identify-noise-bogus", ok + ("--noise", "smooth"), "--noise")
+    add("identify-referred-bogus", ok + ("--referred", "inside"), "--referred")
     for v in ("5", "abc") + big:
         add(f"identify-bootstrap-{v}", ok + ("--bootstrap", v), "--bootstrap")
     add("identify-out-proc", ok + ("--out", "/proc/nope"), "/proc/nope")

@@ -127,3 +127,26 @@ def test_identify_file_of_realisations_with_the_realisations_covariance(tmp_path
     rc = cli.main(["identify", str(one), *ARGS, "--covariance", "realisations", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 2 and "--covariance realisations is for a record of M x P x N" in err
+
+
+def test_identify_file_of_realisations_with_the_distortion_referred_to_the_input(tmp_path, capsys):
+    """--referred input: the fit of DistortionResult.experiments(referred="input", model=first fit)."""
+    src = tmp_path / "rig.npz"
+    u, y = _record(src, cubic=0.5, M=6)
+    out = tmp_path / "out"
+    assert cli.main(["identify", str(src), *ARGS, "--referred", "input", "--out", str(out)]) == 0
+    assert "referred to the input" in capsys.readouterr().out
+    s = json.loads((out / "summary.json").read_text())
+    assert s["referred"] == "input"
+    d = lptv.distortion(u, y, w0=MODEL.w0)
+    rows = [np.arange(2, 62)] * 6
+    first = lptv.identify(d.experiments(), na=1, nb=0, ka=1, kb=1, lines=rows)
+    ref = lptv.identify(d.experiments(referred="input", model=first), na=1, nb=0, ka=1, kb=1, lines=rows)
+    model = lptv.Model.load(out / "model.json")
+    assert np.allclose(model.a, ref.model.a, rtol=1e-9, atol=1e-12)
+    assert np.allclose(model.b, ref.model.b, rtol=1e-9, atol=1e-12)
+    # a record of periods has no realisations to refer
+    per = tmp_path / "periods.npz"
+    np.savez(per, u=u[0], y=y[0], w0=MODEL.w0)
+    assert cli.main(["identify", str(per), *ARGS, "--referred", "input", "--out", str(tmp_path / "o2")]) == 2
+    assert "--referred input is for a record of M x P x N" in capsys.readouterr().err

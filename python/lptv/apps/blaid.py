@@ -74,6 +74,12 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                 top = int(np.max(dist.excited)) + K
                 lines = np.arange(K + 1, min(top, exps[0].max_line - K) + 1)
             per = lines if isinstance(lines, str) else [lines] * M
+            referred = getattr(args, "referred", "output")
+            if referred == "input" and dist.detected:
+                # an actuator's distortion: referred to the input through a first, output-referred fit
+                first = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
+                                 known=known, tol=args.tol, max_iter=args.max_iter)
+                exps = dist.experiments(referred="input", model=first)
             res = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
                            known=known, tol=args.tol, max_iter=args.max_iter, covariance=covariance)
     except (ValueError, NumericalError) as e:
@@ -88,8 +94,10 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                                     ", continuous-time model") + f") -> {out}/")
     print(dist.summary())
     worth = ", ".join(str(e.periods) for e in exps)
+    side = ("referred to the input (a nonlinearity before the dynamics) through a first fit"
+            if getattr(args, "referred", "output") == "input" else "added to the output noise")
     print("model: the best linear approximation, the realisations fitted together with the nonlinear "
-          f"level added to the output noise (their variances worth {worth} periods: the P shown below)"
+          f"level {side} (their variances worth {worth} periods: the P shown below)"
           if dist.detected else "model: the realisations fitted together (no nonlinear level to add)")
     print(res.summary())
     for msg in extra:
@@ -126,6 +134,7 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra):
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "parameters": parameter_table(res), "warnings": list(res.warnings) + extra,
         "covariance": getattr(args, "covariance", "analytic"),
+        "referred": getattr(args, "referred", "output"),
     }
 
 
