@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -45,6 +46,11 @@ LOF_ALL_PERMUTATIONS = 720
 the identity and ``LOF_RANDOM_PERMUTATIONS - 1`` drawn with a fixed seed (the p-value is then
 that of a randomisation test, as exact, with a resolution of 1 / LOF_RANDOM_PERMUTATIONS)."""
 LOF_RANDOM_PERMUTATIONS = 2000
+LOF_CONDITION_MAX = 1e10
+"""A model whose steady state has a larger condition on some line (six of the 16 digits lost)
+has no reliable predicted output there: its lack of fit is not computed, it is rejected."""
+LOF_TRUNCATION_MAX = 1e-6
+"""Nor one whose predicted output carries a larger truncation error (relative to its peak)."""
 
 
 @dataclass(frozen=True)
@@ -77,10 +83,14 @@ class LackOfFit:
     permutations: int
     realisations: int
     alpha: float = ALPHA
+    unreliable: Optional[str] = None
+    """Why the model's predicted output on the data's lines cannot be trusted (its steady state
+    nearly singular on a line, or its truncation error large), else None. A model whose output
+    cannot be computed there is not the best linear approximation: the test then rejects."""
 
     @property
     def rejects(self) -> bool:
-        return bool(self.p_value <= self.alpha)
+        return bool(self.unreliable is not None or self.p_value <= self.alpha)
 
     @property
     def can_reject(self) -> bool:
@@ -93,6 +103,9 @@ class LackOfFit:
 
     def sentence(self) -> str:
         """The verdict's sentence when the test rejects (it is one-sided: a lack of fit)."""
+        if self.unreliable is not None:
+            return ("the model's output on the data's lines cannot be computed reliably, so it is not the best "
+                    f"linear approximation the realisations give ({self.unreliable})")
         return (f"the model departs from the best linear approximation that the {self.realisations} realisations give "
                 f"line by line (lack of fit on {self.lines.size} lines: z = {self.statistic:.2f}, permutation "
                 f"p = {self.p_value:.2g} <= {self.alpha:g}; largest on lines "
@@ -390,7 +403,6 @@ class DistortionResult:
         Y = np.array([s[1] for s in self.spectra]).T
         Uex = np.zeros_like(U)
         Uex[self.excited] = U[self.excited]
-        R = Y - simulate(m, Uex, warn_unstable=False)     # the residual rows of the model
         wanted = self.lines if lines is None else np.unique(np.asarray(as_lines(lines, "lines", minimum=1)))
         bad = wanted[(wanted < 1) | (wanted > self.lines.size)]
         if bad.size:
@@ -412,9 +424,28 @@ class DistortionResult:
         if not judged:
             raise ValueError("lines: no line with a regressor and a residual degree of freedom to judge")
         judged, ranks = np.array(judged), np.array(ranks)
-        Rl = R[judged]                                      # (n, M)
-        total = np.sum(np.abs(Rl) ** 2, axis=1)
         perms = _permutations(M)
+        unreliable = None
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")      # judged below, from the solve's own figures
+                sim = simulate(m, Uex, warn_unstable=False, full_output=True)
+        except _core.NumericalError as e:
+            unreliable = " ".join(str(e).split())
+        else:
+            if not np.all(np.isfinite(sim.Y)):
+                unreliable = "its predicted output is not finite"
+            elif sim.condition > LOF_CONDITION_MAX:
+                unreliable = (f"its steady state is nearly singular on line {sim.condition_line}: condition "
+                              f"{sim.condition:.2g}, a pole within about {1 / sim.condition:.1g} of that line")
+            elif sim.truncation_error > LOF_TRUNCATION_MAX:
+                unreliable = f"the truncation error of its predicted output is {sim.truncation_error:.2g} of its peak"
+        if unreliable is not None:
+            nan = np.full(judged.size, np.nan)
+            return LackOfFit(lines=judged, regressors=ranks, F=nan, p_lines=nan.copy(), statistic=float("nan"),
+                             p_value=0.0, permutations=int(perms.shape[0]), realisations=M, unreliable=unreliable)
+        Rl = (Y - sim.Y)[judged]                            # (n, M): the residual rows of the model
+        total = np.sum(np.abs(Rl) ** 2, axis=1)
 
         def lof_of(block):                                 # (n, len(block)): the lack of fit per permutation
             Rp = Rl[:, block]                              # (n, b, M)

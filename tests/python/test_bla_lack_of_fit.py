@@ -254,3 +254,13 @@ def test_referred_input_needs_a_model_and_a_wide_spacing(cases):
     wide = lptv.Model(a, b, w0=m.w0)
     with pytest.raises(ValueError, match="common spacing \\(8\\) above the model's harmonics \\(K = 9\\)"):
         d.input_level(wide)
+
+
+def test_a_model_whose_output_cannot_be_computed_is_rejected(cases):
+    """A model with a pole on DC (a0 = 0 with na = 1: 1 / (j w)) has no steady state there: its
+    lack of fit is not computed from an unreliable prediction, the model is rejected."""
+    m, d = cases[0]
+    pole = lptv.Model([[0.0], [1.0]], [[1.0]], w0=m.w0)
+    lof = d.lack_of_fit(pole)
+    assert lof.unreliable is not None and lof.rejects
+    assert "cannot be computed reliably" in lof.sentence()
