@@ -79,7 +79,7 @@ def gain(system, c, n=400):
 
 
 def one(args):
-    run, case, c, P, g = args
+    run, case, c, P, g, referred = args
     system, kind, fitted = case.split("/")
     make, excited, N, rows, _, noise = SYSTEMS[system]
     structure = STRUCTURES[(system, fitted)]
@@ -101,6 +101,9 @@ def one(args):
         warnings.simplefilter("ignore")
         d = lptv.distortion(np.array(u), np.array(y), w0=m.w0, ts=m.ts)
         res = lptv.identify(d.experiments(), lines=[rows] * M, method="sml", **structure)
+        if referred == "input":   # the level referred to the input through that first fit
+            res = lptv.identify(d.experiments(referred="input", model=res), lines=[rows] * M, method="sml",
+                                **structure)
         lof = res.lack_of_fit
         old = res.residue_tests
         true_p = np.nan
@@ -138,12 +141,14 @@ def main():
     ap.add_argument("--runs", type=int, default=200)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--cases", nargs="*", help="system/kind/structure[:P] (default: every case)")
+    ap.add_argument("--referred", default="output", choices=("output", "input"),
+                    help="DistortionResult.experiments(referred=...): input refers the level through a first fit")
     args = ap.parse_args()
     cases = CASES
     if args.cases:
         want = [(s.split(":")[0], int(s.split(":")[1]) if ":" in s else None) for s in args.cases]
         cases = [cs for cs in CASES if any(cs[0] == w and (p is None or cs[2] == p) for w, p in want)]
-    print(f"# M = {M} realisations, R = {args.runs} runs per case; load average "
+    print(f"# M = {M} realisations, R = {args.runs} runs per case; the level referred to the {args.referred}; load average "
           f"{' '.join(open('/proc/loadavg').read().split()[:3])} at the start")
     print("| case | c | P | lines | lack of fit rejects at 1 % | at 5 % | true BLA at 1 % | at 5 % | residue tests "
           "reject | lines p < 5 % | p < 1 % | mean z | max abs(bias) / std |")
@@ -154,7 +159,7 @@ def main():
             t0 = time.time()
             system, kind, fitted = case.split("/")
             g = gains.setdefault((system, c), gain(system, c)) if kind == "hammerstein" else 1.0
-            out = list(pool.map(one, [(r, case, c, P, g) for r in range(args.runs)], chunksize=2))
+            out = list(pool.map(one, [(r, case, c, P, g, args.referred) for r in range(args.runs)], chunksize=2))
             R = len(out)
             p = np.array([o["p"] for o in out])
             tp = np.array([o["true_p"] for o in out])
