@@ -37,6 +37,7 @@ import numpy as np  # noqa: E402
 
 import lptv  # noqa: E402
 from lptv import examples as ex  # noqa: E402
+from bench_bla import actuator_gain, exact_bla_eta  # noqa: E402  (the exact BLA: one definition)
 
 M = 6
 SYSTEMS = {
@@ -63,19 +64,6 @@ CASES = [   # system / kind / fitted structure, cubic c, periods
     ("paper/hammerstein/harmonic", 0.05, 4), ("paper/hammerstein/order", 0.05, 4),
     ("paper/wiener/true", 0.02, 4), ("paper/wiener/true", 0.02, 16),
 ]
-
-
-def gain(system, c, n=400):
-    """The actuator's linear gain for the flat random-phase multisine (x = u + c u^3)."""
-    _, excited, N, *_ = SYSTEMS[system]
-    rng = np.random.default_rng(12345)
-    num = den = 0.0
-    for _ in range(n):
-        ms = lptv.multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
-        X = np.fft.rfft(ms.signal + c * ms.signal ** 3) / N
-        num += np.sum(X[excited] * np.conj(ms.spectrum[excited]))
-        den += np.sum(np.abs(ms.spectrum[excited]) ** 2)
-    return float(np.real(num / den))
 
 
 def one(args):
@@ -116,22 +104,6 @@ def one(args):
                 names=tuple(res.eta_names), n_lines=lof.lines.size)
 
 
-def truth_eta(system, g, names):
-    """The exact BLA's parameters in the fit's names (Hammerstein, true structure)."""
-    m = SYSTEMS[system][0]()
-    a, b = np.array(m.a), np.array(m.b) * g
-    out = []
-    for name in names:
-        c, rest = name[0], name[1:]
-        n, part = rest.split(".")
-        arr = a if c == "a" else b
-        K = (arr.shape[1] - 1) // 2
-        k = int(part[2:])
-        z = arr[int(n), K + k] if k <= K else 0.0
-        out.append(np.real(z) if part.startswith("re") else np.imag(z))
-    return np.array(out)
-
-
 def pct(x, n):
     return f"{100 * x:5.1f} +- {100 * np.sqrt(max(x * (1 - x), 1e-12) / n):.1f} %"
 
@@ -158,7 +130,7 @@ def main():
         for case, c, P in cases:
             t0 = time.time()
             system, kind, fitted = case.split("/")
-            g = gains.setdefault((system, c), gain(system, c)) if kind == "hammerstein" else 1.0
+            g = gains.setdefault((system, c), actuator_gain(system, c)) if kind == "hammerstein" else 1.0
             out = list(pool.map(one, [(r, case, c, P, g, args.referred) for r in range(args.runs)], chunksize=2))
             R = len(out)
             p = np.array([o["p"] for o in out])
@@ -170,7 +142,7 @@ def main():
             if kind == "hammerstein" and fitted == "true":
                 eta = np.array([o["eta"] for o in out])
                 free = out[0]["std"] > 0
-                t = truth_eta(system, g, out[0]["names"])
+                t = exact_bla_eta(system, g, out[0]["names"])
                 b = np.abs(eta.mean(0) - t)[free] / eta.std(0, ddof=1)[free]
                 bias = f"{b.max():.2f} (median {np.median(b):.2f}; se of a mean 1/sqrt(R) = {1 / np.sqrt(R):.2f})"
             true_cols = (f"{pct(np.mean(tp <= 0.01), R)} | {pct(np.mean(tp <= 0.05), R)}" if kind == "hammerstein"
