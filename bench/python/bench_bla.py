@@ -46,6 +46,8 @@ SYSTEMS = {
               dict(snr_in_db=50.0, snr_out_db=30.0)),
     "third_order": (ex.third_order_model, ex.THIRD_ORDER_EXCITED, ex.THIRD_ORDER_N, ex.THIRD_ORDER_ID_LINES,
                     ex.THIRD_ORDER_STRUCTURE, dict(snr_in_db=40.0, snr_out_db=25.0)),
+    "discrete": (ex.discrete_model, ex.DISCRETE_EXCITED, ex.DISCRETE_N, ex.DISCRETE_ID_LINES,
+                 ex.DISCRETE_STRUCTURE, dict(snr_in_db=45.0, snr_out_db=30.0, correlation=0.3)),
 }
 
 
@@ -101,15 +103,22 @@ def one(args):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         d = lptv.distortion(u, y, w0=m.w0, ts=m.ts)
-        exps = d.experiments()
-        if referred == "input":   # the level referred to the input through a first (output-referred) fit
-            first = lptv.identify(exps, lines=rows, method="sml", **structure)
-            exps = d.experiments(referred="input", model=first)
-        bla = lptv.identify(exps, lines=rows, method="sml", **structure)
-        jk = lptv.identify(exps, lines=rows, method="sml", covariance="realisations", **structure)
         plain = lptv.identify([(u[i], y[i]) for i in range(M)], w0=m.w0, ts=m.ts, lines=rows, method="sml", **structure)
+        exps = d.experiments()
+        first_plain = False
+        if referred == "input":   # the level referred to the input through a first (output-referred) fit
+            try:
+                first = lptv.identify(exps, lines=rows, method="sml", **structure)
+            except ValueError:    # refused (one common level above a weak realisation's output): the plain fit
+                first, first_plain = plain, True
+            exps = d.experiments(referred="input", model=first)
+        try:
+            bla = lptv.identify(exps, lines=rows, method="sml", **structure)
+        except ValueError as e:   # refused: said in the output, left out of the statistics
+            return (None, None, None, None, None, bool(d.detected), 0, (), False, " ".join(str(e).split())[:160])
+        jk = lptv.identify(exps, lines=rows, method="sml", covariance="realisations", **structure)
     return (bla.eta, bla.parameter_std, jk.parameter_std, plain.eta, plain.parameter_std, bool(d.detected),
-            exps[0].periods, bla.eta_names)
+            exps[0].periods, bla.eta_names, first_plain, None)
 
 
 def main():
@@ -137,12 +146,21 @@ def main():
         out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind, args.structure, args.referred)
                              for r in range(args.runs)],
                             chunksize=4))
-    n = len(out[0][0])
-    bad = [r for r, o in enumerate(out) if any(x is None or np.shape(x) != (n,) for x in o[:5])]
+    refused = [r for r, o in enumerate(out) if o[9] is not None]
+    if refused:
+        print(f"# runs whose BLA fit was refused ({len(refused)}; left out): {refused[:20]}; the first's reason: "
+              f"{out[refused[0]][9]}")
+    plain_first = sum(o[8] for o in out)
+    if plain_first:
+        print(f"# runs whose output-referred first fit was refused, the level referred through the plain fit "
+              f"(noise only): {plain_first}")
+    n = max(len(o[0]) for o in out if o[0] is not None)
+    bad = [r for r, o in enumerate(out) if r not in set(refused) and any(x is None or np.shape(x) != (n,) for x in o[:5])]
     if bad:   # a fit without covariance: said, and left out of the statistics
         print(f"# runs left out (a fit without a covariance or of another size): {bad}")
         for r in bad[:5]:
             print(f"#   run {r}: " + ", ".join("None" if x is None else str(np.shape(x)) for x in out[r][:5]))
+    bad = sorted(set(bad) | set(refused))
     out = [o for r, o in enumerate(out) if r not in set(bad)]
     R = len(out)
     eb, sb, sj, ep, sp, det, pe = (np.array([o[i] for o in out]) for i in range(7))

@@ -1,8 +1,10 @@
+#include <cstdio>
 #include "lptv/likelihood.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -390,6 +392,16 @@ Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& F, const char* what) {
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
     throw NumericalError(std::string(what) + " is singular: the parameters are not identifiable "
                          "from these data (too many harmonics or orders, or too few excited lines)");
+  }
+  // Positive pivots do not make an inverse: below a reciprocal condition of one rounding unit it
+  // has no correct digit (variances of -1e32 were seen at a non-converged, degenerate estimate).
+  const double rc = ldlt.rcond();
+  if (!(rc > std::numeric_limits<double>::epsilon())) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.1e", rc);
+    throw NumericalError(std::string(what) + " is numerically singular (reciprocal condition " + buf +
+                         "): the estimate sits where the parameters are not identifiable (a fit that did "
+                         "not converge, or a degenerate structure)");
   }
   const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
   return 0.5 * (inv + inv.transpose());

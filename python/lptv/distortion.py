@@ -53,6 +53,29 @@ LOF_TRUNCATION_MAX = 1e-6
 """Nor one whose predicted output carries a larger truncation error (relative to its peak)."""
 
 
+def _reliable_response(m, U):
+    """The model's steady-state response to the input spectra ``U`` (the FDS, full output), and
+    None; or None and the reason it cannot be trusted (a NumericalError, a non-finite output, a
+    condition above LOF_CONDITION_MAX on some line, a truncation error above
+    LOF_TRUNCATION_MAX): the solve's own figures, with its warnings silenced."""
+    from .fds import simulate
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")      # judged below, from the solve's own figures
+            sim = simulate(m, U, warn_unstable=False, full_output=True)
+    except _core.NumericalError as e:
+        return None, " ".join(str(e).split())
+    if not np.all(np.isfinite(sim.Y)):
+        return None, "its predicted output is not finite"
+    if sim.condition > LOF_CONDITION_MAX:
+        return None, (f"its steady state is nearly singular on line {sim.condition_line}: condition "
+                      f"{sim.condition:.2g}, a pole within about {1 / sim.condition:.1g} of that line")
+    if sim.truncation_error > LOF_TRUNCATION_MAX:
+        return None, f"the truncation error of its predicted output is {sim.truncation_error:.2g} of its peak"
+    return sim, None
+
+
 @dataclass(frozen=True)
 class LackOfFit:
     """A parametric model of the best linear approximation judged against the per-line
@@ -221,6 +244,12 @@ class DistortionResult:
         output-referred fit was 1.5 std off the exact BLA (the paper's model), the
         input-referred one 0.1 std, with 2.7-2.9 times smaller spread; on Wiener systems (the
         nonlinearity after the dynamics) the output-referred fit is the better one (bench/RESULTS.md).
+        The first fit may be of these experiments, or, where one common level on the outputs
+        swamps a weak realisation (a strongly time-varying system whose output power depends on
+        the phases; :func:`lptv.identify` then refuses it and says so), of the realisations with
+        their noise alone (``lptv.identify([(u[i], y[i]) for i in range(M)], ...)``). A first
+        model whose branches cannot be computed reliably on the lines (a pole on a line, as a fit
+        one order short may stop at) is refused with a ``ValueError`` naming ``model``.
 
         Examples
         --------
@@ -279,7 +308,6 @@ class DistortionResult:
             A first fit of the best linear approximation (e.g. of :meth:`experiments`): its
             branches refer the output level to the input.
         """
-        from .fds import simulate
         from .model import Model
 
         width = as_int(width, "width")
@@ -301,7 +329,12 @@ class DistortionResult:
         E = np.zeros((L + 1, lat.size + 1), complex)       # unit inputs on the multiples of s and on DC
         E[lat, np.arange(lat.size)] = 1.0
         E[0, lat.size] = 1.0
-        G = simulate(m, E, warn_unstable=False)
+        sim, unreliable = _reliable_response(m, E)
+        if unreliable is not None:
+            raise ValueError(f"model: its branches cannot refer the level to the input ({unreliable}); "
+                             "fit the approximation with a structure whose fit converges, or refer the level "
+                             "to the output")
+        G = sim.Y
         g0 = np.abs(G[lat, np.arange(lat.size)]) ** 2
         ok = np.isfinite(self.p_value[lat - 1]) & (g0 > 1e-12 * max(float(g0.max()), 1e-300))
         raw = np.where(ok, (self.total[lat - 1] - self.noise[lat - 1]) / np.where(ok, g0, 1.0), np.nan)
@@ -386,7 +419,6 @@ class DistortionResult:
         """
         from scipy import stats
 
-        from .fds import simulate
         from .model import Model
 
         m = getattr(model, "model", model)
@@ -425,21 +457,7 @@ class DistortionResult:
             raise ValueError("lines: no line with a regressor and a residual degree of freedom to judge")
         judged, ranks = np.array(judged), np.array(ranks)
         perms = _permutations(M)
-        unreliable = None
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")      # judged below, from the solve's own figures
-                sim = simulate(m, Uex, warn_unstable=False, full_output=True)
-        except _core.NumericalError as e:
-            unreliable = " ".join(str(e).split())
-        else:
-            if not np.all(np.isfinite(sim.Y)):
-                unreliable = "its predicted output is not finite"
-            elif sim.condition > LOF_CONDITION_MAX:
-                unreliable = (f"its steady state is nearly singular on line {sim.condition_line}: condition "
-                              f"{sim.condition:.2g}, a pole within about {1 / sim.condition:.1g} of that line")
-            elif sim.truncation_error > LOF_TRUNCATION_MAX:
-                unreliable = f"the truncation error of its predicted output is {sim.truncation_error:.2g} of its peak"
+        sim, unreliable = _reliable_response(m, Uex)
         if unreliable is not None:
             nan = np.full(judged.size, np.nan)
             return LackOfFit(lines=judged, regressors=ranks, F=nan, p_lines=nan.copy(), statistic=float("nan"),

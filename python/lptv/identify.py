@@ -692,8 +692,11 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
     if several:
         rows = _experiment_rows(datas, lines, max(ka_l + kb_l))
-        r = _core.identify_experiments([d._cpp for d in datas], structure, method=method, tol=float(tol),
-                                       max_iter=int(max_iter), rows=rows)
+        try:
+            r = _core.identify_experiments([d._cpp for d in datas], structure, method=method, tol=float(tol),
+                                           max_iter=int(max_iter), rows=rows)
+        except ValueError as e:
+            raise ValueError(_with_distortion_hint(str(e), datas)) from None
     else:
         if isinstance(lines, str):
             if lines != "excited":
@@ -862,6 +865,26 @@ def _jackknife(r, structure, datas, rows, method, tol, max_iter):
     for i in norm:
         cov[i, :] = cov[:, i] = 0.0
     return cov
+
+
+def _with_distortion_hint(msg: str, datas) -> str:
+    """A refusal of a realisation of DistortionResult.experiments() as a dead output channel: the
+    common nonlinear level on the output variances is above that realisation's output (its output
+    power differs widely from the others', e.g. a strongly time-varying system whose response
+    depends on the phases). Said, with what to do instead."""
+    import re
+
+    hit = re.match(r"experiment (\d+): y: the output shows no variation above its noise", msg)
+    if hit is None or getattr(datas[0], "distortion", None) is None:
+        return msg
+    e = int(hit.group(1))
+    power = [float(np.sum(np.abs(np.asarray(d.Y)) ** 2)) for d in datas]
+    return (msg + f". These are realisations of a DistortionResult with one common nonlinear level on their "
+            f"output variances; realisation {e}'s output power is {power[e] / max(power):.2g} of the largest "
+            f"({min(power) / max(power):.2g} at the least), below that level. Refer the level to the input "
+            f"instead: d.experiments(referred='input', model=...) with a first fit of the realisations with "
+            f"their noise alone (lptv.identify([(u[i], y[i]) for i in range(M)], ...)), or fit only the "
+            f"realisations whose outputs stand above the level")
 
 
 def _experiment_rows(datas, lines, K):
