@@ -82,7 +82,7 @@ def exact_bla_eta(system, g, names):
 
 
 def one(args):
-    run, c, P, M, system, kind, fitted, referred = args
+    run, c, P, M, system, kind, fitted, referred, first_fit = args
     make, excited, N, rows, structure, noise = SYSTEMS[system]
     structure = fitted or structure
     rng = np.random.default_rng([run, 77])
@@ -106,12 +106,14 @@ def one(args):
         plain = lptv.identify([(u[i], y[i]) for i in range(M)], w0=m.w0, ts=m.ts, lines=rows, method="sml", **structure)
         exps = d.experiments()
         first_plain = False
-        if referred == "input":   # the level referred to the input through a first (output-referred) fit
-            try:
-                first = lptv.identify(exps, lines=rows, method="sml", **structure)
-            except ValueError:    # refused (one common level above a weak realisation's output): the plain fit
-                first, first_plain = plain, True
-            exps = d.experiments(referred="input", model=first)
+        if referred == "input" and first_fit == "plain":   # through the fit of the realisations' noise alone
+            exps, first_plain = d.experiments(referred="input", model=plain), True
+        elif referred == "input":   # through a first, output-referred fit; the plain one where that is refused
+            try:               # (one common level above a weak realisation's output, or branches unreliable)
+                exps = d.experiments(referred="input", model=lptv.identify(exps, lines=rows, method="sml",
+                                                                          **structure))
+            except ValueError:
+                exps, first_plain = d.experiments(referred="input", model=plain), True
         try:
             bla = lptv.identify(exps, lines=rows, method="sml", **structure)
         except ValueError as e:   # refused: said in the output, left out of the statistics
@@ -136,6 +138,9 @@ def main():
     ap.add_argument("--referred", default="output", choices=("output", "input"),
                     help="DistortionResult.experiments(referred=...): the nonlinear level on the output variances, or "
                          "referred to the input through a first fit (for a nonlinearity before the dynamics)")
+    ap.add_argument("--first", default="output", choices=("output", "plain"),
+                    help="--referred input: the first fit that refers the level, output-referred (the plain fit where "
+                         "that is refused) or the plain fit of the realisations with their noise alone")
     ap.add_argument("--kind", default="wiener", choices=("wiener", "hammerstein"),
                     help="the cubic after the LPTV system (y + c y^3) or before it (x = u + c u^3: the exact BLA "
                          "is then known, and the coverage around it is printed too)")
@@ -143,7 +148,8 @@ def main():
     M = args.realisations
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as pool:
-        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind, args.structure, args.referred)
+        out = list(pool.map(one, [(r, args.cubic, args.periods, M, args.system, args.kind, args.structure, args.referred,
+                                   args.first)
                              for r in range(args.runs)],
                             chunksize=4))
     refused = [r for r, o in enumerate(out) if o[9] is not None]
@@ -152,8 +158,8 @@ def main():
               f"{out[refused[0]][9]}")
     plain_first = sum(o[8] for o in out)
     if plain_first:
-        print(f"# runs whose output-referred first fit was refused, the level referred through the plain fit "
-              f"(noise only): {plain_first}")
+        print(f"# runs whose level was referred through the plain fit (noise only): {plain_first}"
+              + (" (the output-referred first fit refused)" if args.first == "output" else " (--first plain)"))
     n = max(len(o[0]) for o in out if o[0] is not None)
     bad = [r for r, o in enumerate(out) if r not in set(refused) and any(x is None or np.shape(x) != (n,) for x in o[:5])]
     if bad:   # a fit without covariance: said, and left out of the statistics
@@ -178,7 +184,7 @@ def main():
         print(f"# Hammerstein: the actuator's linear gain g = {g:.5f}; the exact BLA is the LPTV system with b times g")
     if args.structure:
         print(f"# fitted structure {args.structure}")
-    print(f"# the nonlinear level referred to the {args.referred}")
+    print(f"# the nonlinear level referred to the {args.referred}" + (f" (first fit: {args.first})" if args.referred == "input" else ""))
     print(f"# {R} runs in {time.time() - t0:.0f} s; system {args.system} ({args.kind}), cubic c = {args.cubic}, M = {M}, "
           f"P = {args.periods}; distortion detected in {100 * det.mean():.0f} % of the runs; effective periods "
           f"{pe.min()}-{pe.max()}")
