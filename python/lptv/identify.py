@@ -98,6 +98,10 @@ class IdentificationResult:
     moderation: Tuple[object, ...] = field(default_factory=tuple, repr=False, compare=False)
     """noise='moderated': per experiment, the :class:`lptv.ModeratedNoise` the fit used (None for
     an experiment whose variances could not be moderated); empty otherwise."""
+    covariance_dof: Optional[np.ndarray] = field(default=None, repr=False, compare=False)
+    """covariance='realisations': per entry of ``eta``, the degrees of freedom behind its variance
+    (M - 1 for realisations of equal information, fewer where a few carry most of it; the
+    variance is scaled so that eta +- 1.96 std is the t interval with them); None otherwise."""
     disturbances: Tuple[object, ...] = field(default_factory=tuple, repr=False, compare=False)
     """disturbances='remove': the :class:`lptv.Disturbance` sinusoids (off the period's grid)
     found in the records and subtracted before the fit; empty otherwise or when none was found."""
@@ -720,11 +724,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
                     + ": its predicted steady state is the periodic solution of its equation, which "
                     "a simulation from rest does not reach (fine for data from a stabilised experiment)")
         warnings.warn(unstable, UnstableModelWarning, stacklevel=2)
+    cov_dof = None
     if covariance == "bootstrap":
         cov = _bootstrap(r, model, structure, data, several, method, tol, max_iter, bootstrap, seed)
     elif covariance == "realisations":
-        cov = _jackknife(r, structure, datas if several else None, rows if several else None, method, tol,
-                         max_iter)
+        cov, cov_dof = _jackknife(r, structure, datas if several else None, rows if several else None, method, tol,
+                                  max_iter)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -738,7 +743,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
         unstable=unstable, stability_undecided=undecided, structure=structure, noise=noise,
-        moderation=moderation, disturbances=found)
+        moderation=moderation, disturbances=found, covariance_dof=cov_dof)
 
 
 def _without_disturbances(u, y, several):
@@ -818,11 +823,16 @@ def _bootstrap(r, model, structure, data, several, method, tol, max_iter, B, see
     return cov
 
 
-def realisation_covariance(estimates) -> np.ndarray:
+def realisation_covariance(estimates, dof=None) -> np.ndarray:
     """The covariance of a fit of E independent realisations from its E leave-one-out refits
     (``estimates``, shape (E, n)): the jackknife (E-1)/E sum_e (eta_(e) - mean)(eta_(e) - mean)^T,
     times (E-1)/(E-3), the variance of Student's t with E-1 degrees of freedom, so that
     eta +- 1.96 std covers like the t interval (METHOD.md section 16).
+
+    ``dof`` (optional, one per entry of eta, each in [1, E-1]): the degrees of freedom the
+    jackknife has per parameter when the realisations carry unequal information
+    (:func:`realisation_dof`); entry j is then scaled by (t_{dof_j} / t_{E-1})^2 at 97.5 %, so
+    that eta +- 1.96 std stays a 95 % interval (the same matrix when every dof is E-1).
 
     Examples
     --------
@@ -830,13 +840,56 @@ def realisation_covariance(estimates) -> np.ndarray:
     >>> est = np.array([[1.0], [2.0], [3.0], [4.0], [5.0]])       # E = 5 refits
     >>> float(realisation_covariance(est)[0, 0])                   # 4/5 * 10 * 4/2
     16.0
+    >>> round(float(realisation_covariance(est, dof=[1.0])[0, 0]), 1)   # 16 (12.706 / 2.776)^2
+    335.1
     """
     est = np.asarray(estimates, dtype=float)
     E = est.shape[0]
     if E < 4:
         raise ValueError(f"covariance='realisations' needs at least 4 experiments, got {E}")
     d = est - est.mean(axis=0)
-    return (E - 1) / E * (d.T @ d) * (E - 1) / (E - 3)
+    cov = (E - 1) / E * (d.T @ d) * (E - 1) / (E - 3)
+    if dof is None:
+        return cov
+    from scipy import stats
+
+    nu = np.asarray(dof, dtype=float)
+    if nu.shape != (est.shape[1],) or not np.all(np.isfinite(nu)) or np.any(nu < 1) or np.any(nu > E - 1):
+        raise ValueError(f"dof must give one value in [1, {E - 1}] per parameter ({est.shape[1]}), got {dof!r}")
+    s = stats.t.ppf(0.975, nu) / stats.t.ppf(0.975, E - 1)
+    return cov * np.outer(s, s)
+
+
+def realisation_dof(informations, free, n_eta: int) -> np.ndarray:
+    """The jackknife's degrees of freedom per entry of eta when E realisations carry unequal
+    information: ``informations`` the E Fisher informations H_e of the realisations at the
+    estimate (over the free parameters, at eta positions ``free``). Realisation e's share of
+    the variance of parameter j is s_ej = (H^-1 H_e H^-1)_jj, H = sum_e H_e; a sum of E
+    independent squared terms with those variances has Satterthwaite's (sum_e s_ej)^2 /
+    sum_e s_ej^2 degrees of freedom, E for equal shares; one less for the estimated centre,
+    clipped to [1, E-1]. Entries of eta that are not free get E - 1 (METHOD.md section 16).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> H = [np.eye(1) * w for w in (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)]    # six equal realisations
+    >>> realisation_dof(H, [0], 1).tolist()
+    [5.0]
+    >>> H = [np.eye(1) * w for w in (100.0, 1.0, 1.0, 1.0, 1.0, 1.0)]  # one carries 95 %
+    >>> round(float(realisation_dof(H, [0], 1)[0]), 2)
+    1.0
+    """
+    Hs = [np.asarray(h, dtype=float) for h in informations]
+    E = len(Hs)
+    Hi = np.linalg.inv(sum(Hs))
+    s = np.array([np.diag(Hi @ h @ Hi) for h in Hs])          # (E, n_free)
+    nu = np.full(int(n_eta), float(E - 1))
+    tot, sq = s.sum(axis=0), (s ** 2).sum(axis=0)
+    ok = sq > 0
+    nu_free = np.full(s.shape[1], float(E - 1))
+    nu_free[ok] = np.clip(tot[ok] ** 2 / sq[ok] - 1.0, 1.0, E - 1.0)
+    nu[np.asarray(free, dtype=int)] = nu_free
+    return nu
 
 
 def _jackknife(r, structure, datas, rows, method, tol, max_iter):
@@ -860,11 +913,23 @@ def _jackknife(r, structure, datas, rows, method, tol, max_iter):
                                         max_iter=int(max_iter), rows=[per[e] for e in keep],
                                         covariance=False)
         est.append(np.asarray(rk.eta))
-    cov = realisation_covariance(est)
+    # Unequal realisations (a strongly time-varying system whose output power depends on the
+    # phases): the jackknife has fewer degrees of freedom than E - 1 (METHOD.md section 16).
+    dof = None
+    try:
+        par = _core.Parametrisation(structure)
+        free = [i for i in par.free_indices if i < par.n_eta]
+        theta = np.asarray(r.theta)
+        H = [np.asarray(_core.ExactLikelihood(datas[e]._cpp, par, per[e]).fisher_information(theta)) for e in range(E)]
+        if all(h.shape == (len(free), len(free)) for h in H):
+            dof = realisation_dof(H, free, par.n_eta)
+    except (np.linalg.LinAlgError, _core.NumericalError, ValueError):
+        dof = None          # the shares cannot be formed: E - 1, as for equal realisations
+    cov = realisation_covariance(est, dof=dof)
     norm = [i for i in range(cov.shape[0]) if np.allclose(cov[i], 0.0)]
     for i in norm:
         cov[i, :] = cov[:, i] = 0.0
-    return cov
+    return cov, (np.full(cov.shape[0], float(E - 1)) if dof is None else dof)
 
 
 def _with_distortion_hint(msg: str, datas) -> str:

@@ -1,5 +1,6 @@
 """The parametric BLA's covariance from the realisations (lptv.identify(..., covariance='realisations'),
-METHOD.md section 16): the leave-one-realisation-out jackknife of the joint fit times (M-1)/(M-3).
+METHOD.md section 16): the leave-one-realisation-out jackknife of the joint fit times (M-1)/(M-3),
+scaled to the t quantile of the degrees of freedom the realisations' shares of the information give.
 
 The nonlinear distortion of an LPTV Wiener system is correlated between neighbouring lines (its
 coherence between lines j and j+1 is about 0.8 on the paper's model with a cubic), which the
@@ -10,6 +11,7 @@ import warnings
 
 import numpy as np
 import pytest
+from scipy import stats
 
 import lptv
 from lptv.identify import realisation_covariance
@@ -48,8 +50,12 @@ def test_the_covariance_is_the_jackknife_of_the_leave_one_out_refits():
                         for k in range(6)])
     assert np.array_equal(res.eta, ana.eta)
     d = loo - loo.mean(0)
-    expect = 5 / 6 * (d.T @ d) * 5 / 3
+    # scaled to the t quantile of each parameter's degrees of freedom (the realisations' shares
+    # of the information; near M - 1 = 5 for these nearly equal realisations)
+    s = stats.t.ppf(0.975, res.covariance_dof) / stats.t.ppf(0.975, 5)
+    expect = 5 / 6 * (d.T @ d) * 5 / 3 * np.outer(s, s)
     free = ana.parameter_std > 0
+    assert np.all(res.covariance_dof[free] > 3.5) and np.all(res.covariance_dof <= 5)
     assert np.allclose(res.covariance[np.ix_(free, free)], expect[np.ix_(free, free)], rtol=1e-9,
                        atol=1e-12 * np.max(np.abs(expect)))
     assert np.all(res.covariance[~free] == 0) and np.all(res.covariance[:, ~free] == 0)
