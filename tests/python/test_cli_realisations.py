@@ -7,6 +7,7 @@ purely LPTV record must show no distortion. Readers other than ``lptv identify F
 such a file with a message naming the option.
 """
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -150,3 +151,47 @@ def test_identify_file_of_realisations_with_the_distortion_referred_to_the_input
     np.savez(per, u=u[0], y=y[0], w0=MODEL.w0)
     assert cli.main(["identify", str(per), *ARGS, "--referred", "input", "--out", str(tmp_path / "o2")]) == 2
     assert "--referred input is for a record of M x P x N" in capsys.readouterr().err
+
+
+def test_referred_input_falls_back_to_a_plain_first_fit_where_the_output_referred_one_is_refused(tmp_path, capsys):
+    """The discrete-time example after a cubic actuator: one common output level swamps a weak
+    realisation, so the output-referred first fit is refused; the level is referred through a
+    fit of the realisations with their noise alone, as the refusal advises, and the command says
+    so. The model is the library's on the same route."""
+    from lptv.examples import DISCRETE_EXCITED, DISCRETE_ID_LINES, DISCRETE_N, DISCRETE_STRUCTURE, discrete_model
+
+    m = discrete_model()
+    rng = np.random.default_rng([1, 77])
+    u, y = [], []
+    for _ in range(6):
+        ms = lptv.multisine(DISCRETE_EXCITED, DISCRETE_N, amplitudes=np.sqrt(2 / DISCRETE_EXCITED.size), seed=rng)
+        y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + 0.05 * ms.signal ** 3) / DISCRETE_N),
+                              DISCRETE_N)
+        a, b = noisy_periods(ms.signal, y0, 8, 45.0, 30.0, correlation=0.3, seed=rng)
+        u.append(a)
+        y.append(b)
+    u, y = np.array(u), np.array(y)
+    src = tmp_path / "dt.npz"
+    np.savez(src, u=u, y=y, w0=m.w0)
+    out = tmp_path / "out"
+    args = ["identify", str(src), "--ts", "1", "--na", "2", "--nb", "1", "--ka", "2,1,0", "--kb", "2,0",
+            "--lines", "1-125", "--method", "sml", "--referred", "input", "--covariance", "realisations",
+            "--out", str(out)]
+    assert cli.main(args) == 0
+    printed = capsys.readouterr().out
+    assert "through a first fit of the realisations with their noise alone" in printed
+    s = json.loads((out / "summary.json").read_text())
+    assert s["first_fit"].startswith("a first fit of the realisations with their noise alone")
+    d = lptv.distortion(u, y, w0=m.w0, ts=1.0)
+    rows = [DISCRETE_ID_LINES] * 6
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = lptv.identify([(u[i], y[i]) for i in range(6)], w0=m.w0, ts=1.0, lines=rows, method="sml",
+                              **DISCRETE_STRUCTURE)
+        ref = lptv.identify(d.experiments(referred="input", model=plain), lines=rows, method="sml",
+                            covariance="realisations", **DISCRETE_STRUCTURE)
+    model = lptv.Model.load(out / "model.json")
+    assert np.allclose(model.b, ref.model.b, rtol=1e-9, atol=1e-12)
+    assert np.allclose(model.a, ref.model.a, rtol=1e-9, atol=1e-12)
+    assert s["covariance_dof"] == pytest.approx(list(ref.covariance_dof), rel=1e-9)
+

@@ -75,11 +75,21 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                 lines = np.arange(K + 1, min(top, exps[0].max_line - K) + 1)
             per = lines if isinstance(lines, str) else [lines] * M
             referred = getattr(args, "referred", "output")
+            first_fit = None
             if referred == "input" and dist.detected:
-                # an actuator's distortion: referred to the input through a first, output-referred fit
-                first = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
-                                 known=known, tol=args.tol, max_iter=args.max_iter)
-                exps = dist.experiments(referred="input", model=first)
+                # an actuator's distortion: referred to the input through a first, output-referred
+                # fit; where that is refused (one common level above a weak realisation's output)
+                # or its branches are unreliable, through a fit of the realisations' noise alone
+                fit_args = dict(na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method, known=known,
+                                tol=args.tol, max_iter=args.max_iter)
+                try:
+                    exps = dist.experiments(referred="input", model=identify(exps, **fit_args))
+                    first_fit = "an output-referred first fit"
+                except ValueError as e:
+                    plain = identify([(meas.u[i], meas.y[i]) for i in range(M)], w0=w0, ts=ts, **fit_args)
+                    exps = dist.experiments(referred="input", model=plain)
+                    first_fit = ("a first fit of the realisations with their noise alone (the output-referred "
+                                 f"one: {' '.join(str(e).split())[:160]}...)")
             res = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
                            known=known, tol=args.tol, max_iter=args.max_iter, covariance=covariance)
     except (ValueError, NumericalError) as e:
@@ -94,7 +104,7 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                                     ", continuous-time model") + f") -> {out}/")
     print(dist.summary())
     worth = ", ".join(str(e.periods) for e in exps)
-    side = ("referred to the input (a nonlinearity before the dynamics) through a first fit"
+    side = (f"referred to the input (a nonlinearity before the dynamics) through {first_fit or 'a first fit'}"
             if getattr(args, "referred", "output") == "input" else "added to the output noise")
     print("model: the best linear approximation, the realisations fitted together with the nonlinear "
           f"level {side} (their variances worth {worth} periods: the P shown below)"
@@ -102,7 +112,7 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     print(res.summary())
     for msg in extra:
         print(f"warning: {msg}")
-    summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra)
+    summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit)
     failed = write_fit(out, res.model, summary, lambda: _report(src, meas, dist, res, summary))
     return _fail(failed[0] or src, failed[1]) if failed else 0
 
@@ -121,7 +131,7 @@ def _levels(dist):
     return out
 
 
-def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra):
+def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None):
     M, P, N = meas.u.shape
     return {
         "file": str(src), "format": meas.format, "realisations": M, "periods": P, "samples_per_period": N,
@@ -134,7 +144,8 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra):
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "parameters": parameter_table(res), "warnings": list(res.warnings) + extra,
         "covariance": getattr(args, "covariance", "analytic"),
-        "referred": getattr(args, "referred", "output"),
+        "referred": getattr(args, "referred", "output"), "first_fit": first_fit,
+        "covariance_dof": None if res.covariance_dof is None else [float(v) for v in res.covariance_dof],
     }
 
 
