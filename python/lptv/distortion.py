@@ -535,11 +535,16 @@ def _default_branches(src, lines, spacing, M):
     best = max(spacing - 1, 0)
     if M - 2 >= src.size:                       # every excited line fits on every output line
         return int(lines.size)
-    for Kh in range(best, int(lines.size) + 1):
-        if _most_regressors(src, lines, Kh) > M - 2:
-            break
-        best = Kh
-    return best
+    if _most_regressors(src, lines, best) > M - 2:
+        return best
+    lo, hi = best, int(lines.size) + 1          # the count grows with Kh: ok at lo, too many at hi
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if _most_regressors(src, lines, mid) > M - 2:
+            hi = mid
+        else:
+            lo = mid
+    return lo
 
 
 def distortion(u, y, *, w0: float, ts: Optional[float] = None, branches: Optional[int] = None,
