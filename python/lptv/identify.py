@@ -447,8 +447,18 @@ class IdentificationResult:
                          f"{lof.lines.size} lines; the largest on lines {', '.join(str(int(j)) for j in lof.worst())})")
         from .parameters import format_parameter_table
 
-        lines.append("parameters" + (" (no covariance with this method)" if self.covariance is None else "")
-                     + ":")
+        if self.covariance is None:
+            head = " (no covariance with this method)"
+        elif self.covariance_dof is not None:
+            dof = self.covariance_dof[self.parameter_std > 0] if np.any(self.parameter_std > 0) else self.covariance_dof
+            head = (f" (intervals from the {self.n_experiments} realisations' jackknife, its degrees of freedom "
+                    f"{dof.min():.3g}-{dof.max():.3g})")
+        elif lof is not None:
+            head = (" (analytic intervals take the lines' distortion independent; measured to cover 78-97 % per "
+                    "parameter, less with the level referred to the input: covariance='realisations' is calibrated)")
+        else:
+            head = ""
+        lines.append("parameters" + head + ":")
         lines.append(format_parameter_table(self))
         lines.append(f"verdict: {self.verdict}")
         lines += [f"warning: {w}" for w in self.warnings]

@@ -380,3 +380,9 @@ def test_the_jackknife_counts_the_realisations_that_carry_the_information(cases)
     plain = 5 / 6 * np.sum(dev ** 2, axis=0) * 5 / 3
     scale = (stats.t.ppf(0.975, res.covariance_dof) / stats.t.ppf(0.975, 5)) ** 2
     np.testing.assert_allclose(np.diag(res.covariance)[dt_free], (plain * scale)[dt_free], rtol=1e-6)
+    # and the summary says which intervals these are
+    assert f"jackknife, its degrees of freedom {res.covariance_dof[dt_free].min():.3g}-" in res.summary()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        analytic = lptv.identify(exps, lines=rows, method="sml", **DISCRETE_STRUCTURE)
+    assert "analytic intervals take the lines' distortion independent" in analytic.summary()
