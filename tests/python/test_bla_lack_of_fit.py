@@ -177,6 +177,36 @@ def test_the_figure_of_the_lines_runs_its_example(cases):
     assert ax.get_xlabel() == "frequency (Hz)" and "not rejected" in ax.get_title()
 
 
+def _actuator_gain(exc, N, c):
+    """The linear gain of x = u + c u^3 for the flat random-phase multisine on lines ``exc``
+    (200 realisations): the exact BLA of a Hammerstein system is the LPTV system with b times it."""
+    rng = np.random.default_rng(3)
+    num = den = 0.0
+    for _ in range(200):
+        ms = lptv.multisine(exc, N, amplitudes=np.sqrt(2 / exc.size), seed=rng)
+        X = np.fft.rfft(ms.signal + c * ms.signal ** 3) / N
+        num += np.sum(X[exc] * np.conj(ms.spectrum[exc]))
+        den += np.sum(np.abs(ms.spectrum[exc]) ** 2)
+    return float(np.real(num / den))
+
+
+def _discrete_hammerstein(seed, M=6, c=0.05):
+    """M realisations x 8 periods of the discrete-time example after the actuator x = u + c u^3
+    (its outputs' powers differ widely with the phases), and their DistortionResult."""
+    m = discrete_model()
+    rng = np.random.default_rng([seed, 77])
+    u, y = [], []
+    for _ in range(M):
+        ms = lptv.multisine(DISCRETE_EXCITED, DISCRETE_N, amplitudes=np.sqrt(2 / DISCRETE_EXCITED.size), seed=rng)
+        y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + c * ms.signal ** 3) / DISCRETE_N),
+                              DISCRETE_N)
+        a, b = noisy_periods(ms.signal, y0, 8, 45.0, 30.0, correlation=0.3, seed=rng)
+        u.append(a)
+        y.append(b)
+    u, y = np.array(u), np.array(y)
+    return m, u, y, lptv.distortion(u, y, w0=m.w0, ts=m.ts)
+
+
 def _paper_hammerstein(seed, M=6, P=4, c=0.05):
     m = paper_model()
     rng = np.random.default_rng([seed, 77])
@@ -189,14 +219,7 @@ def _paper_hammerstein(seed, M=6, P=4, c=0.05):
         a, b = noisy_periods(ms.signal, y0, P, 50.0, 30.0, seed=rng)
         u.append(a)
         y.append(b)
-    rng = np.random.default_rng(3)       # the actuator's linear gain for this flat multisine
-    num = den = 0.0
-    for _ in range(200):
-        ms = lptv.multisine(exc, N, amplitudes=np.sqrt(2 / exc.size), seed=rng)
-        X = np.fft.rfft(ms.signal + c * ms.signal ** 3) / N
-        num += np.sum(X[exc] * np.conj(ms.spectrum[exc]))
-        den += np.sum(np.abs(ms.spectrum[exc]) ** 2)
-    g = float(np.real(num / den))
+    g = _actuator_gain(exc, N, c)
     return m, g, lptv.distortion(np.array(u), np.array(y), w0=m.w0)
 
 
@@ -303,17 +326,8 @@ def test_a_realisation_below_the_common_level_is_refused_with_the_way_out():
     level referred to the input through a first fit of the realisations with their noise alone)
     lies within t_5's 99.9 % quantile (6.87) of the exact BLA in its jackknife std, and its lack
     of fit keeps it."""
-    m = discrete_model()
-    rng = np.random.default_rng([1, 77])
+    m, u, y, d = _discrete_hammerstein(1)
     N, exc, c = DISCRETE_N, DISCRETE_EXCITED, 0.05
-    u, y = [], []
-    for _ in range(6):
-        ms = lptv.multisine(exc, N, amplitudes=np.sqrt(2 / exc.size), seed=rng)
-        y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + c * ms.signal ** 3) / N), N)
-        a, b = noisy_periods(ms.signal, y0, 8, 45.0, 30.0, correlation=0.3, seed=rng)
-        u.append(a)
-        y.append(b)
-    d = lptv.distortion(np.array(u), np.array(y), w0=m.w0, ts=m.ts)
     rows = [DISCRETE_ID_LINES] * 6
     with pytest.raises(ValueError, match="one common nonlinear level on their output variances; realisation 2's "
                                          "output power is 0.13 of the largest.*Refer the level to the input"):
@@ -324,14 +338,7 @@ def test_a_realisation_below_the_common_level_is_refused_with_the_way_out():
                               **DISCRETE_STRUCTURE)
         res = lptv.identify(d.experiments(referred="input", model=first), lines=rows, method="sml",
                             covariance="realisations", **DISCRETE_STRUCTURE)
-    rng = np.random.default_rng(3)       # the actuator's linear gain for this flat multisine
-    num = den = 0.0
-    for _ in range(200):
-        ms = lptv.multisine(exc, N, amplitudes=np.sqrt(2 / exc.size), seed=rng)
-        X = np.fft.rfft(ms.signal + c * ms.signal ** 3) / N
-        num += np.sum(X[exc] * np.conj(ms.spectrum[exc]))
-        den += np.sum(np.abs(ms.spectrum[exc]) ** 2)
-    g = float(np.real(num / den))
+    g = _actuator_gain(exc, N, c)
     truth = _eta_of(lptv.Model(np.array(m.a), np.array(m.b) * g, w0=m.w0, ts=m.ts), res.eta_names)
     free = res.parameter_std > 0
     assert np.max(np.abs(res.eta - truth)[free] / res.parameter_std[free]) < 6.87
@@ -344,17 +351,7 @@ def test_the_jackknife_counts_the_realisations_that_carry_the_information(cases)
     jackknife about one degree of freedom per parameter; the third-order system's realisations,
     nearly equal, keep nearly M - 1 = 5. The variances are scaled to the t quantile with them
     (bench/RESULTS.md: the discrete-time intervals' coverage 89 % -> 97 % at M = 12)."""
-    m = discrete_model()
-    rng = np.random.default_rng([1, 77])
-    u, y = [], []
-    for _ in range(6):
-        ms = lptv.multisine(DISCRETE_EXCITED, DISCRETE_N, amplitudes=np.sqrt(2 / DISCRETE_EXCITED.size), seed=rng)
-        y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + 0.05 * ms.signal ** 3) / DISCRETE_N),
-                              DISCRETE_N)
-        a, b = noisy_periods(ms.signal, y0, 8, 45.0, 30.0, correlation=0.3, seed=rng)
-        u.append(a)
-        y.append(b)
-    d = lptv.distortion(np.array(u), np.array(y), w0=m.w0, ts=m.ts)
+    m, u, y, d = _discrete_hammerstein(1)
     rows = [DISCRETE_ID_LINES] * 6
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
