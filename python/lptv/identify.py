@@ -833,16 +833,17 @@ def _bootstrap(r, model, structure, data, several, method, tol, max_iter, B, see
     return cov
 
 
-def realisation_covariance(estimates, dof=None) -> np.ndarray:
+def realisation_covariance(estimates, dof=None, ratio=None) -> np.ndarray:
     """The covariance of a fit of E independent realisations from its E leave-one-out refits
     (``estimates``, shape (E, n)): the jackknife (E-1)/E sum_e (eta_(e) - mean)(eta_(e) - mean)^T,
     times (E-1)/(E-3), the variance of Student's t with E-1 degrees of freedom, so that
     eta +- 1.96 std covers like the t interval (METHOD.md section 16).
 
-    ``dof`` (optional, one per entry of eta, each in [1, E-1]): the degrees of freedom the
-    jackknife has per parameter when the realisations carry unequal information
-    (:func:`realisation_dof`); entry j is then scaled by (t_{dof_j} / t_{E-1})^2 at 97.5 %, so
-    that eta +- 1.96 std stays a 95 % interval (the same matrix when every dof is E-1).
+    ``dof``, ``ratio`` (optional, one per entry of eta): when the realisations carry unequal
+    information (:func:`realisation_terms`), the jackknife's degrees of freedom per parameter (in
+    [1, E-1]) and its bias factor; entry j is then scaled by ratio_j (t_{dof_j} / t_{E-1})^2 at
+    97.5 %, so that eta +- 1.96 std stays a 95 % interval (the same matrix when every dof is
+    E - 1 and every ratio 1).
 
     Examples
     --------
@@ -850,8 +851,8 @@ def realisation_covariance(estimates, dof=None) -> np.ndarray:
     >>> est = np.array([[1.0], [2.0], [3.0], [4.0], [5.0]])       # E = 5 refits
     >>> float(realisation_covariance(est)[0, 0])                   # 4/5 * 10 * 4/2
     16.0
-    >>> round(float(realisation_covariance(est, dof=[1.0])[0, 0]), 1)   # 16 (12.706 / 2.776)^2
-    335.1
+    >>> round(float(realisation_covariance(est, dof=[1.0], ratio=[0.5])[0, 0]))  # 16 0.5 (12.706 / 2.776)^2
+    168
     """
     est = np.asarray(estimates, dtype=float)
     E = est.shape[0]
@@ -859,47 +860,68 @@ def realisation_covariance(estimates, dof=None) -> np.ndarray:
         raise ValueError(f"covariance='realisations' needs at least 4 experiments, got {E}")
     d = est - est.mean(axis=0)
     cov = (E - 1) / E * (d.T @ d) * (E - 1) / (E - 3)
-    if dof is None:
-        return cov
-    from scipy import stats
+    n = est.shape[1]
+    s = np.ones(n)
+    if dof is not None:
+        from scipy import stats
 
-    nu = np.asarray(dof, dtype=float)
-    if nu.shape != (est.shape[1],) or not np.all(np.isfinite(nu)) or np.any(nu < 1) or np.any(nu > E - 1):
-        raise ValueError(f"dof must give one value in [1, {E - 1}] per parameter ({est.shape[1]}), got {dof!r}")
-    s = stats.t.ppf(0.975, nu) / stats.t.ppf(0.975, E - 1)
+        nu = np.asarray(dof, dtype=float)
+        if nu.shape != (n,) or not np.all(np.isfinite(nu)) or np.any(nu < 1) or np.any(nu > E - 1):
+            raise ValueError(f"dof must give one value in [1, {E - 1}] per parameter ({n}), got {dof!r}")
+        s = s * stats.t.ppf(0.975, nu) / stats.t.ppf(0.975, E - 1)
+    if ratio is not None:
+        q = np.asarray(ratio, dtype=float)
+        if q.shape != (n,) or not np.all(np.isfinite(q)) or np.any(q <= 0):
+            raise ValueError(f"ratio must give one positive value per parameter ({n}), got {ratio!r}")
+        s = s * np.sqrt(q)
     return cov * np.outer(s, s)
 
 
-def realisation_dof(informations, free, n_eta: int) -> np.ndarray:
-    """The jackknife's degrees of freedom per entry of eta when E realisations carry unequal
-    information: ``informations`` the E Fisher informations H_e of the realisations at the
-    estimate (over the free parameters, at eta positions ``free``). Realisation e's share of
-    the variance of parameter j is s_ej = (H^-1 H_e H^-1)_jj, H = sum_e H_e; a sum of E
-    independent squared terms with those variances has Satterthwaite's (sum_e s_ej)^2 /
-    sum_e s_ej^2 degrees of freedom, E for equal shares; one less for the estimated centre,
-    clipped to [1, E-1]. Entries of eta that are not free get E - 1 (METHOD.md section 16).
+def realisation_terms(informations, free, n_eta: int):
+    """The jackknife's degrees of freedom and its bias factor per entry of eta when E
+    realisations carry unequal information (METHOD.md section 16). ``informations``: the E
+    Fisher informations H_e of the realisations at the estimate (over the free parameters, at
+    eta positions ``free``), H = sum_e H_e.
+
+    Linearised at the estimate (where the scores sum to zero), the leave-one-out deviation of
+    realisation e has covariance V_e = A_e (H_e - H_e H^-1 H_e) A_e, A_e = (H - H_e)^-1. The
+    jackknife (E-1)/E sum_e (eta_(e) - mean)^2 then expects (E-1)/E sum_e (V_e)_jj where the
+    estimate's variance is (H^-1)_jj: ``ratio`` is their quotient (1 for equal realisations;
+    below 1 where one realisation's absence moves the fit far). As a sum of E independent
+    squared terms with variances (V_e)_jj it has Satterthwaite's (sum_e V_e,jj)^2 / sum_e V_e,jj^2
+    degrees of freedom, clipped to [1, E-1] (E - 1 for equal realisations). Entries of eta that
+    are not free get E - 1 and 1. Raises numpy.linalg.LinAlgError when H - H_e is singular (a
+    realisation alone carries some parameter).
 
     Examples
     --------
     >>> import numpy as np
     >>> H = [np.eye(1) * w for w in (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)]    # six equal realisations
-    >>> realisation_dof(H, [0], 1).tolist()
-    [5.0]
+    >>> [round(float(v[0]), 12) for v in realisation_terms(H, [0], 1)]
+    [5.0, 1.0]
     >>> H = [np.eye(1) * w for w in (100.0, 1.0, 1.0, 1.0, 1.0, 1.0)]  # one carries 95 %
-    >>> round(float(realisation_dof(H, [0], 1)[0]), 2)
-    1.0
+    >>> dof, ratio = realisation_terms(H, [0], 1)
+    >>> round(float(dof[0]), 3), round(float(ratio[0]), 4)
+    (1.005, 0.0599)
     """
     Hs = [np.asarray(h, dtype=float) for h in informations]
     E = len(Hs)
-    Hi = np.linalg.inv(sum(Hs))
-    s = np.array([np.diag(Hi @ h @ Hi) for h in Hs])          # (E, n_free)
+    H = sum(Hs)
+    Hi = np.linalg.inv(H)
+    v = []
+    for h in Hs:
+        A = np.linalg.inv(H - h)
+        v.append(np.diag(A @ (h - h @ Hi @ h) @ A))
+    v = np.array(v)                                            # (E, n_free)
+    tot, sq = v.sum(axis=0), (v ** 2).sum(axis=0)
+    if not (np.all(np.isfinite(v)) and np.all(tot > 0)):
+        raise np.linalg.LinAlgError("the leave-one-out terms are not positive")
     nu = np.full(int(n_eta), float(E - 1))
-    tot, sq = s.sum(axis=0), (s ** 2).sum(axis=0)
-    ok = sq > 0
-    nu_free = np.full(s.shape[1], float(E - 1))
-    nu_free[ok] = np.clip(tot[ok] ** 2 / sq[ok] - 1.0, 1.0, E - 1.0)
-    nu[np.asarray(free, dtype=int)] = nu_free
-    return nu
+    ratio = np.ones(int(n_eta))
+    free = np.asarray(free, dtype=int)
+    nu[free] = np.clip(tot ** 2 / sq, 1.0, E - 1.0)
+    ratio[free] = np.diag(Hi) / ((E - 1) / E * tot)
+    return nu, ratio
 
 
 def _jackknife(r, structure, datas, rows, method, tol, max_iter):
@@ -925,17 +947,17 @@ def _jackknife(r, structure, datas, rows, method, tol, max_iter):
         est.append(np.asarray(rk.eta))
     # Unequal realisations (a strongly time-varying system whose output power depends on the
     # phases): the jackknife has fewer degrees of freedom than E - 1 (METHOD.md section 16).
-    dof = None
+    dof = ratio = None
     try:
         par = _core.Parametrisation(structure)
         free = [i for i in par.free_indices if i < par.n_eta]
         theta = np.asarray(r.theta)
         H = [np.asarray(_core.ExactLikelihood(datas[e]._cpp, par, per[e]).fisher_information(theta)) for e in range(E)]
         if all(h.shape == (len(free), len(free)) for h in H):
-            dof = realisation_dof(H, free, par.n_eta)
+            dof, ratio = realisation_terms(H, free, par.n_eta)
     except (np.linalg.LinAlgError, _core.NumericalError, ValueError):
-        dof = None          # the shares cannot be formed: E - 1, as for equal realisations
-    cov = realisation_covariance(est, dof=dof)
+        dof = ratio = None   # the terms cannot be formed: E - 1 and the plain jackknife
+    cov = realisation_covariance(est, dof=dof, ratio=ratio)
     norm = [i for i in range(cov.shape[0]) if np.allclose(cov[i], 0.0)]
     for i in norm:
         cov[i, :] = cov[:, i] = 0.0

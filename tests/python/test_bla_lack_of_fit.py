@@ -348,9 +348,10 @@ def test_a_realisation_below_the_common_level_is_refused_with_the_way_out():
 def test_the_jackknife_counts_the_realisations_that_carry_the_information(cases):
     """covariance='realisations' with unequal realisations: the discrete-time example after a
     cubic actuator, where one realisation's output (and information) dominates, leaves the
-    jackknife about one degree of freedom per parameter; the third-order system's realisations,
-    nearly equal, keep nearly M - 1 = 5. The variances are scaled to the t quantile with them
-    (bench/RESULTS.md: the discrete-time intervals' coverage 89 % -> 97 % at M = 12)."""
+    jackknife about one degree of freedom per parameter and a jackknife biased upward; the
+    third-order system's realisations, nearly equal, keep M - 1 = 5 and the plain jackknife. The
+    variances are scaled to the t quantile and by the bias factor (bench/RESULTS.md: the
+    discrete-time intervals' coverage 89 % -> 95 % at M = 12)."""
     m, u, y, d = _discrete_hammerstein(1)
     rows = [DISCRETE_ID_LINES] * 6
     with warnings.catch_warnings():
@@ -366,8 +367,18 @@ def test_the_jackknife_counts_the_realisations_that_carry_the_information(cases)
         equal = lptv.identify(cases[0][1].experiments(), lines=[THIRD_ORDER_ID_LINES] * 6, method="sml",
                               covariance="realisations", **THIRD_ORDER_STRUCTURE)
     free = equal.parameter_std > 0
-    assert np.all(equal.covariance_dof[free] > 3.5) and np.median(equal.covariance_dof[free]) > 4.0
-    # the variances: the plain jackknife of the leave-one-out refits times (t_dof / t_5)^2
+    assert np.all(equal.covariance_dof[free] > 4.5)
+    texps = cases[0][1].experiments()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        tloo = np.array([lptv.identify([texps[e] for e in range(6) if e != k], lines=[THIRD_ORDER_ID_LINES] * 5,
+                                       method="sml", **THIRD_ORDER_STRUCTURE).eta for k in range(6)])
+    tdev = tloo - tloo.mean(axis=0)
+    tscale = (stats.t.ppf(0.975, equal.covariance_dof) / stats.t.ppf(0.975, 5)) ** 2
+    timplied = np.diag(equal.covariance)[free] / (5 / 6 * np.sum(tdev ** 2, axis=0) * 5 / 3 * tscale)[free]
+    # nearly equal realisations: the plain jackknife, its bias factor within 2 % of 1
+    assert np.all(np.abs(timplied - 1) < 0.02)
+    # the variances: the plain jackknife of the leave-one-out refits times (t_dof / t_5)^2 ...
     exps = d.experiments(referred="input", model=first)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -376,7 +387,10 @@ def test_the_jackknife_counts_the_realisations_that_carry_the_information(cases)
     dev = loo - loo.mean(axis=0)
     plain = 5 / 6 * np.sum(dev ** 2, axis=0) * 5 / 3
     scale = (stats.t.ppf(0.975, res.covariance_dof) / stats.t.ppf(0.975, 5)) ** 2
-    np.testing.assert_allclose(np.diag(res.covariance)[dt_free], (plain * scale)[dt_free], rtol=1e-6)
+    # ... and by the bias factor: the realisation that carries the fit moves the refit without
+    # it far, so the plain jackknife overstates the variance (here 2-3 times)
+    implied = np.diag(res.covariance)[dt_free] / (plain * scale)[dt_free]
+    assert np.all((0.2 < implied) & (implied < 0.75))
     # and the summary says which intervals these are
     assert f"jackknife, its degrees of freedom {res.covariance_dof[dt_free].min():.3g}-" in res.summary()
     with warnings.catch_warnings():

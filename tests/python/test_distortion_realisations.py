@@ -50,12 +50,17 @@ def test_the_covariance_is_the_jackknife_of_the_leave_one_out_refits():
                         for k in range(6)])
     assert np.array_equal(res.eta, ana.eta)
     d = loo - loo.mean(0)
-    # scaled to the t quantile of each parameter's degrees of freedom (the realisations' shares
-    # of the information; near M - 1 = 5 for these nearly equal realisations)
+    # scaled to the t quantile of each parameter's degrees of freedom and by the jackknife's bias
+    # factor (both from the realisations' informations; M - 1 = 5 and about 1 for these nearly
+    # equal realisations): a diagonal scaling D C D of the plain jackknife
     s = stats.t.ppf(0.975, res.covariance_dof) / stats.t.ppf(0.975, 5)
-    expect = 5 / 6 * (d.T @ d) * 5 / 3 * np.outer(s, s)
+    plain = 5 / 6 * (d.T @ d) * 5 / 3 * np.outer(s, s)
     free = ana.parameter_std > 0
     assert np.all(res.covariance_dof[free] > 3.5) and np.all(res.covariance_dof <= 5)
+    q = np.ones(free.size)
+    q[free] = np.sqrt(np.diag(res.covariance)[free] / np.diag(plain)[free])
+    assert np.all(np.abs(q[free] ** 2 - 1) < 0.05)
+    expect = plain * np.outer(q, q)
     assert np.allclose(res.covariance[np.ix_(free, free)], expect[np.ix_(free, free)], rtol=1e-9,
                        atol=1e-12 * np.max(np.abs(expect)))
     assert np.all(res.covariance[~free] == 0) and np.all(res.covariance[:, ~free] == 0)
