@@ -88,8 +88,10 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                 except ValueError as e:
                     plain = identify([(meas.u[i], meas.y[i]) for i in range(M)], w0=w0, ts=ts, **fit_args)
                     exps = dist.experiments(referred="input", model=plain)
+                    why = re.sub(r"experiments?\[(\d+)\]|experiment (\d+)",
+                                 lambda g: f"realisation {g.group(1) or g.group(2)}", " ".join(str(e).split()))
                     first_fit = ("a first fit of the realisations with their noise alone (the output-referred "
-                                 f"one: {' '.join(str(e).split())[:160]}...)")
+                                 f"one: {why[:160]}...)")
             res = identify(exps, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per, method=args.method,
                            known=known, tol=args.tol, max_iter=args.max_iter, covariance=covariance)
     except (ValueError, NumericalError) as e:
@@ -129,6 +131,14 @@ def _levels(dist):
                 for name, x in (("signal_db", dist.signal), ("noise_db", dist.noise),
                                 ("nonlinear_db", dist.nonlinear))}}
     return out
+
+
+def _dof_range(res):
+    """The jackknife's degrees of freedom over the free parameters, as a phrase."""
+    if res.covariance_dof is None or res.parameter_std is None:
+        return "not formed"
+    dof = res.covariance_dof[res.parameter_std > 0] if np.any(res.parameter_std > 0) else res.covariance_dof
+    return f"{dof.min():.3g}-{dof.max():.3g} for {res.n_experiments} realisations"
 
 
 def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None):
@@ -174,13 +184,19 @@ def _report(src, meas, dist, res, summary) -> Report:
         f"The model: na = {model.na}, nb = {model.nb}, {summary['ka']} harmonics on the a_n and "
         f"{summary['kb']} on the b_m ({res.n_free_parameters} free parameters), identified by "
         f"{res.method.upper()} from the {M} realisations fitted together ({res.lines.size} lines in all)"
-        + (", each output variance raised by the nonlinear level: the best linear time-periodic "
-           "approximation, whose covariance includes the nonlinear distortion. Each realisation's raised "
-           "variance is worth more periods than it has (the P of the summary below: the degrees of "
-           "freedom of noise and level together, METHOD.md section 16)." if dist.detected else ".")
-        + (" The parameter covariance is the jackknife over the realisations (each left out in turn, "
-           "times (M-1)/(M-3)), which holds whatever the distortion's correlation across lines."
-           if summary.get("covariance") == "realisations" else ""))
+        + ((", each input variance raised by the nonlinear level referred to the input through "
+            + (summary.get("first_fit") or "a first fit")
+            + " (a nonlinearity before the dynamics): the best linear time-periodic approximation."
+            if summary.get("referred") == "input" else
+            ", each output variance raised by the nonlinear level: the best linear time-periodic "
+            "approximation, whose covariance includes the nonlinear distortion.")
+           + " Each realisation's raised variance is worth more periods than it has (the P of the summary "
+           "below: the degrees of freedom of noise and level together, METHOD.md section 16)."
+           if dist.detected else ".")
+        + (" The parameter covariance is the jackknife over the realisations (each left out in turn), "
+           "which holds whatever the distortion's correlation across lines, corrected for realisations "
+           "of unequal information and scaled to the t quantile of its degrees of freedom ("
+           + _dof_range(res) + ")." if summary.get("covariance") == "realisations" else ""))
     rep.paragraph("Verdict: " + res.verdict + ".")
     if res.lack_of_fit is not None:
         rep.figure(plots.lack_of_fit(res.lack_of_fit, w0=model.w0).figure, "lack_of_fit.png",
