@@ -23,6 +23,13 @@ M - 1 degrees of freedom) and the coverage that of the t interval, 94.7 % at M =
     python bench/python/bench_bla.py --runs 1000 --cubic 0.02 --periods 4
     python bench/python/bench_bla.py --runs 1000 --cubic 0.02 --periods 16
     python bench/python/bench_bla.py --system third_order --runs 1000 --cubic 0.1 --periods 8
+    python bench/python/bench_bla.py --system discrete --kind hammerstein --referred input --first plain \
+        --realisations 12 --runs 400 --cubic 0.05 --periods 8
+
+The discrete-time system (lptv.examples.discrete_model) is strongly time-varying: its
+realisations' outputs differ widely with the phases (one common output level swamps the weak
+ones, so the level is referred to the input, through the plain fit with --first plain or where
+the output-referred first fit is refused) and its far branches need M >= 12.
 """
 from __future__ import annotations
 
