@@ -255,6 +255,12 @@ class DistortionResult:
         model whose branches cannot be computed reliably on the lines (a pole on a line, as a fit
         one order short may stop at) is refused with a ``ValueError`` naming ``model``.
 
+        Where the response depends on the phases (:attr:`output_spread` above 4: far HTF
+        branches), neither level is an exact noise model: on the discrete-time example the
+        input-referred fit was biased, more so with more realisations, while the fit of the
+        realisations with their noise alone and ``covariance="realisations"`` was not; a
+        ``UserWarning`` says so (METHOD.md section 16).
+
         Examples
         --------
         >>> import numpy as np, lptv
@@ -283,6 +289,14 @@ class DistortionResult:
                 raise ValueError("model: referred='input' needs a first fit's model (e.g. lptv.identify("
                                  "d.experiments(), ...).model) for the branches that refer the level to the input")
             lu = self.input_level(model, width)
+        if self.detected and self.output_spread > OUTPUT_SPREAD_MAX:
+            warnings.warn(f"the realisations' output powers differ up to {self.output_spread:.3g} times (a response "
+                          "that depends on the phases): the nonlinear level "
+                          + ("referred to the input" if referred == "input" else "on the outputs")
+                          + " is no exact noise model there (on the discrete-time example the input-referred fit "
+                          "was biased, more so with more realisations); the fit of the realisations with their "
+                          "noise alone and covariance='realisations' is consistent (METHOD.md section 16)",
+                          UserWarning, stacklevel=2)
         out = []
         for m, (U, Y, varU, varY, cov) in enumerate(self.spectra):
             P_eff = self.effective_periods(varY, nl, width)

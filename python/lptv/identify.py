@@ -978,10 +978,11 @@ def _with_distortion_hint(msg: str, datas) -> str:
     power = [float(np.sum(np.abs(np.asarray(d.Y)) ** 2)) for d in datas]
     return (msg + f". These are realisations of a DistortionResult with one common nonlinear level on their "
             f"output variances; realisation {e}'s output power is {power[e] / max(power):.2g} of the largest "
-            f"({min(power) / max(power):.2g} at the least), below that level. Refer the level to the input "
-            f"instead: d.experiments(referred='input', model=...) with a first fit of the realisations with "
-            f"their noise alone (lptv.identify([(u[i], y[i]) for i in range(M)], ...)), or fit only the "
-            f"realisations whose outputs stand above the level")
+            f"({min(power) / max(power):.2g} at the least), below that level. A response that depends on the "
+            f"phases this much has far HTF branches: fit the realisations with their noise alone and the "
+            f"jackknife over them (lptv.identify([(u[i], y[i]) for i in range(M)], ..., "
+            f"covariance='realisations')), which is consistent there; or refer the level to the input "
+            f"(d.experiments(referred='input', model=that fit)), more efficient where the branches are few")
 
 
 def _experiment_rows(datas, lines, K):

@@ -49,6 +49,9 @@ def cases():
 def test_nearly_equal_realisations_are_not_flagged(cases):
     for _, d in cases:
         assert d.output_spread < 1.5 and "output powers differ" not in d.summary()
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            d.experiments()
 
 
 def test_each_line_is_the_nested_regression_f_test(cases):
@@ -336,9 +339,12 @@ def test_a_realisation_below_the_common_level_is_refused_with_the_way_out():
     # the summary says so before any fit: the outputs' powers differ 52 times (random phases
     # leave a weakly time-varying system's within 1.4 times)
     assert d.output_spread > 40 and "output powers differ up to" in d.summary()
+    with pytest.warns(UserWarning, match="output powers differ up to 52.1 times.*is consistent"):
+        d.experiments()
     rows = [DISCRETE_ID_LINES] * 6
     with pytest.raises(ValueError, match="one common nonlinear level on their output variances; realisation 2's "
-                                         "output power is 0.13 of the largest.*Refer the level to the input"):
+                                         "output power is 0.13 of the largest.*noise alone and the jackknife"
+                                         ".*or refer the level to the input"), pytest.warns(UserWarning):
         lptv.identify(d.experiments(), lines=rows, method="sml", **DISCRETE_STRUCTURE)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -387,7 +393,8 @@ def test_the_jackknife_counts_the_realisations_that_carry_the_information(cases)
     # nearly equal realisations: the plain jackknife, its bias factor within 2 % of 1
     assert np.all(np.abs(timplied - 1) < 0.02)
     # the variances: the plain jackknife of the leave-one-out refits times (t_dof / t_5)^2 ...
-    exps = d.experiments(referred="input", model=first)
+    with pytest.warns(UserWarning, match="referred to the input is no exact noise model"):
+        exps = d.experiments(referred="input", model=first)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         loo = np.array([lptv.identify([exps[e] for e in range(6) if e != k], lines=rows[:5], method="sml",
