@@ -60,25 +60,6 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0, double
 
 namespace {
 
-// The inverse of an SML information matrix: refused (NumericalError, reported as "no covariance")
-// when a pivot is not positive or the reciprocal condition is below one rounding unit, where the
-// inverse has no correct digit.
-Eigen::MatrixXd information_inverse(const Eigen::MatrixXd& F) {
-  Eigen::LDLT<Eigen::MatrixXd> ldlt(F);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0))
-    throw NumericalError("the Fisher information is singular");
-  const double rc = ldlt.rcond();
-  if (!(rc > std::numeric_limits<double>::epsilon())) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.1e", rc);
-    throw NumericalError(std::string("the Fisher information is numerically singular (reciprocal condition ") +
-                         buf + "): the estimate sits where the parameters are not identifiable (a fit that "
-                         "did not converge, or a degenerate structure)");
-  }
-  Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
-  return 0.5 * (inv + inv.transpose());
-}
-
 // Every variance of a covariance finite and not negative, or a NumericalError: a negative
 // variance is rounding that swamped the result, never a reportable interval.
 void check_variances(const Eigen::MatrixXd& cov) {
@@ -268,7 +249,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
           if (opt.method == Method::SML) {
             // The information the fit's last step computed at this very theta (the same sum).
             Eigen::MatrixXd F = er.information.size() ? er.information : lik.fisher_information(er.theta);
-            cov_free = information_inverse(F);
+            cov_free = symmetric_inverse(F, "the Fisher information");
           } else {
             // The sandwich with the estimating equation's second-order noise in its meat.
             const auto t = lik.sandwich_terms(er.theta, w);
@@ -304,7 +285,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
           // One lambda for all experiments: the second-order terms add before they combine.
           if (opt.method != Method::SML) meat += second_order_meat(second, p, er.theta);
           if (opt.method == Method::SML) {
-            cov_free = information_inverse(bread);
+            cov_free = symmetric_inverse(bread, "the Fisher information");
           } else {
             cov_free = sandwich_from_terms(bread, meat);
           }

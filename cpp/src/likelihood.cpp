@@ -1,4 +1,3 @@
-#include <cstdio>
 #include "lptv/likelihood.hpp"
 
 #include <algorithm>
@@ -387,6 +386,8 @@ Eigen::MatrixXd free_columns(const Eigen::MatrixXd& J, const std::vector<int>& f
   return out;
 }
 
+}  // namespace
+
 Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& F, const char* what) {
   Eigen::LDLT<Eigen::MatrixXd> ldlt(F);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
@@ -406,8 +407,6 @@ Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& F, const char* what) {
   const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(F.rows(), F.cols()));
   return 0.5 * (inv + inv.transpose());
 }
-
-}  // namespace
 
 Eigen::MatrixXd ExactLikelihood::fisher_information(const Eigen::VectorXcd& theta) const {
   const Evaluation ev = evaluate(theta);

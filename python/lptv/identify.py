@@ -975,7 +975,7 @@ def _with_distortion_hint(msg: str, datas) -> str:
     if hit is None or getattr(datas[0], "distortion", None) is None:
         return msg
     e = int(hit.group(1))
-    power = [float(np.sum(np.abs(np.asarray(d.Y)) ** 2)) for d in datas]
+    power = [float(np.sum(np.abs(np.asarray(d.Y)[1:]) ** 2)) for d in datas]   # as output_spread
     return (msg + f". These are realisations of a DistortionResult with one common nonlinear level on their "
             f"output variances; realisation {e}'s output power is {power[e] / max(power):.2g} of the largest "
             f"({min(power) / max(power):.2g} at the least), below that level. A response that depends on the "

@@ -135,6 +135,11 @@ Eigen::MatrixXd second_order_meat(const ExactLikelihood::SecondOrderTerms& t, co
 // H^{-1} meat H^{-1} (symmetrised); NumericalError when H is singular.
 Eigen::MatrixXd sandwich_from_terms(const Eigen::MatrixXd& bread, const Eigen::MatrixXd& meat);
 
+// The inverse of a symmetric information matrix ``what``: NumericalError when a pivot of its
+// LDL^T is not positive, or when its reciprocal condition is at or below one rounding unit (the
+// inverse then has no correct digit; METHOD.md section 15).
+Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& F, const char* what);
+
 // The Cramer-Rao bound of eta for a design: `noiseless` holds the true spectra U, Y and the
 // true (co)variances of the noise on them; theta the true parameters. n_eta x n_eta, zero row
 // and column for the normalised parameter.
