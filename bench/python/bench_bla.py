@@ -25,6 +25,8 @@ M - 1 degrees of freedom) and the coverage that of the t interval, 94.7 % at M =
     python bench/python/bench_bla.py --system third_order --runs 1000 --cubic 0.1 --periods 8
     python bench/python/bench_bla.py --system discrete --kind hammerstein --referred input --first plain \
         --realisations 12 --runs 400 --cubic 0.05 --periods 8
+    python bench/python/bench_bla.py --system discrete --kind hammerstein --referred none \
+        --realisations 12 --runs 2000 --cubic 0.05 --periods 8
 
 The discrete-time system (lptv.examples.discrete_model) is strongly time-varying: its
 realisations' outputs differ widely with the phases (one common output level swamps the weak
@@ -47,29 +49,8 @@ import numpy as np  # noqa: E402
 import lptv  # noqa: E402
 from lptv import examples as ex  # noqa: E402
 
-SYSTEMS = {
-    # model, excited lines, N, fit rows, structure, noise (snr_in, snr_out, colour/correlation)
-    "paper": (ex.paper_model, ex.PAPER_EXCITED, ex.PAPER_N, ex.PAPER_ID_LINES, dict(na=2, nb=1, ka=3, kb=3),
-              dict(snr_in_db=50.0, snr_out_db=30.0)),
-    "third_order": (ex.third_order_model, ex.THIRD_ORDER_EXCITED, ex.THIRD_ORDER_N, ex.THIRD_ORDER_ID_LINES,
-                    ex.THIRD_ORDER_STRUCTURE, dict(snr_in_db=40.0, snr_out_db=25.0)),
-    "discrete": (ex.discrete_model, ex.DISCRETE_EXCITED, ex.DISCRETE_N, ex.DISCRETE_ID_LINES,
-                 ex.DISCRETE_STRUCTURE, dict(snr_in_db=45.0, snr_out_db=30.0, correlation=0.3)),
-}
-
-
-def actuator_gain(system, c, n=400):
-    """Hammerstein: the linear gain of x = u + c u^3 for the flat random-phase multisine, over n
-    realisations (the exact BLA is the LPTV system with b times it)."""
-    _, excited, N, *_ = SYSTEMS[system]
-    rng = np.random.default_rng(12345)
-    num = den = 0.0
-    for _ in range(n):
-        ms = lptv.multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
-        X = np.fft.rfft(ms.signal + c * ms.signal ** 3) / N
-        num += np.sum(X[excited] * np.conj(ms.spectrum[excited]))
-        den += np.sum(np.abs(ms.spectrum[excited]) ** 2)
-    return float(np.real(num / den))
+SYSTEMS = ex.BLA_SYSTEMS   # model, excited lines, N, fit rows, structure, noise (snr_in, snr_out, correlation)
+actuator_gain = ex.actuator_gain   # the exact BLA's gain: one definition (lptv.examples)
 
 
 def exact_bla_eta(system, g, names):
@@ -90,22 +71,10 @@ def exact_bla_eta(system, g, names):
 
 def one(args):
     run, c, P, M, system, kind, fitted, referred, first_fit = args
-    make, excited, N, rows, structure, noise = SYSTEMS[system]
+    rows, structure = SYSTEMS[system][3:5]
     structure = fitted or structure
-    rng = np.random.default_rng([run, 77])
-    m = make()
-    u, y = [], []
-    for _ in range(M):
-        ms = lptv.multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
-        if kind == "hammerstein":   # the cubic before the LPTV system (an actuator)
-            y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + c * ms.signal ** 3) / N), N)
-        else:                       # after it (Wiener)
-            y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), N)
-            y0 = y0 + c * y0 ** 3
-        a, b = ex.noisy_periods(ms.signal, y0, P, seed=rng, **noise)
-        u.append(a)
-        y.append(b)
-    u, y = np.array(u), np.array(y)
+    r = ex.cubic_realisations(system, c, "input" if kind == "hammerstein" else "output", M, P, seed=[run, 77])
+    m, u, y = r["model"], r["u"], r["y"]
     rows = [rows] * M
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -113,7 +82,9 @@ def one(args):
         plain = lptv.identify([(u[i], y[i]) for i in range(M)], w0=m.w0, ts=m.ts, lines=rows, method="sml", **structure)
         exps = d.experiments()
         first_plain = False
-        if referred == "input" and first_fit == "plain":   # through the fit of the realisations' noise alone
+        if referred == "none":     # the realisations with their noise alone (the jackknife brings the distortion)
+            exps = d.experiments(referred="none")
+        elif referred == "input" and first_fit == "plain":   # through the fit of the realisations' noise alone
             exps, first_plain = d.experiments(referred="input", model=plain), True
         elif referred == "input":   # through a first, output-referred fit; the plain one where that is refused
             try:               # (one common level above a weak realisation's output, or branches unreliable)
@@ -142,9 +113,11 @@ def main():
     ap.add_argument("--structure", type=json.loads, default=None,
                     help='the fitted structure as JSON, e.g. \'{"na": 3, "nb": 1, "ka": [2, 1, 0, 1], "kb": [3, 0]}\' '
                          "(default: the system's own)")
-    ap.add_argument("--referred", default="output", choices=("output", "input"),
-                    help="DistortionResult.experiments(referred=...): the nonlinear level on the output variances, or "
-                         "referred to the input through a first fit (for a nonlinearity before the dynamics)")
+    ap.add_argument("--referred", default="output", choices=("output", "input", "none"),
+                    help="DistortionResult.experiments(referred=...): the nonlinear level on the output variances, "
+                         "referred to the input through a first fit (for a nonlinearity before the dynamics), or "
+                         "none (the realisations with their noise alone: the 'analytic' column is then the noise's "
+                         "covariance only, the 'realisations' column the jackknife's)")
     ap.add_argument("--first", default="output", choices=("output", "plain"),
                     help="--referred input: the first fit that refers the level, output-referred (the plain fit where "
                          "that is refused) or the plain fit of the realisations with their noise alone")

@@ -40,14 +40,7 @@ from lptv import examples as ex  # noqa: E402
 from bench_bla import actuator_gain, exact_bla_eta  # noqa: E402  (the exact BLA: one definition)
 
 M = 6   # the default number of realisations per run (--realisations)
-SYSTEMS = {
-    "paper": (ex.paper_model, ex.PAPER_EXCITED, ex.PAPER_N, ex.PAPER_ID_LINES, dict(na=2, nb=1, ka=3, kb=3),
-              dict(snr_in_db=50.0, snr_out_db=30.0)),
-    "third_order": (ex.third_order_model, ex.THIRD_ORDER_EXCITED, ex.THIRD_ORDER_N, ex.THIRD_ORDER_ID_LINES,
-                    ex.THIRD_ORDER_STRUCTURE, dict(snr_in_db=40.0, snr_out_db=25.0)),
-    "discrete": (ex.discrete_model, ex.DISCRETE_EXCITED, ex.DISCRETE_N, ex.DISCRETE_ID_LINES,
-                 ex.DISCRETE_STRUCTURE, dict(snr_in_db=45.0, snr_out_db=30.0, correlation=0.3)),
-}
+SYSTEMS = ex.BLA_SYSTEMS
 STRUCTURES = {   # the fitted structure: true, one harmonic / one order short, or richer
     ("paper", "true"): dict(na=2, nb=1, ka=3, kb=3),
     ("paper", "harmonic"): dict(na=2, nb=1, ka=[3, 2, 3], kb=3),
@@ -76,22 +69,10 @@ CASES = [   # system / kind / fitted structure, cubic c, periods
 def one(args):
     run, case, c, P, g, referred, M = args
     system, kind, fitted = case.split("/")
-    make, excited, N, rows, _, noise = SYSTEMS[system]
+    rows = SYSTEMS[system][3]
     structure = STRUCTURES[(system, fitted)]
-    rng = np.random.default_rng([run, 77])
-    m = make()
-    u, y = [], []
-    for _ in range(M):
-        ms = lptv.multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
-        if kind == "hammerstein":
-            x = ms.signal + c * ms.signal ** 3
-            y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(x) / N), N)
-        else:
-            y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), N)
-            y0 = y0 + c * y0 ** 3
-        a, b = ex.noisy_periods(ms.signal, y0, P, seed=rng, **noise)
-        u.append(a)
-        y.append(b)
+    r = ex.cubic_realisations(system, c, "input" if kind == "hammerstein" else "output", M, P, seed=[run, 77])
+    m, u, y = r["model"], r["u"], r["y"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         d = lptv.distortion(np.array(u), np.array(y), w0=m.w0, ts=m.ts)
@@ -102,7 +83,8 @@ def one(args):
         refused = dict(p=0.0, stat=np.nan, p_lines=np.array([]), true_p=true_p, old_rejects=True,
                        detected=bool(d.detected), eta=None, std=None, names=None, n_lines=0, refused=True)
         try:        # refused where one common level swamps a weak realisation (the discrete-time system)
-            res = lptv.identify(d.experiments(), lines=[rows] * M, method="sml", **structure)
+            res = lptv.identify(d.experiments(referred="none" if referred == "none" else "output"),
+                                lines=[rows] * M, method="sml", **structure)
         except ValueError:
             res = None
         if referred == "input":   # the level referred to the input through a first fit: the output-
@@ -146,8 +128,9 @@ def main():
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--cases", nargs="*", help="system/kind/structure[:P] (default: every case)")
     ap.add_argument("--realisations", type=int, default=6, help="M per run")
-    ap.add_argument("--referred", default="output", choices=("output", "input"),
-                    help="DistortionResult.experiments(referred=...): input refers the level through a first fit")
+    ap.add_argument("--referred", default="output", choices=("output", "input", "none"),
+                    help="DistortionResult.experiments(referred=...): input refers the level through a first fit; "
+                         "none fits the realisations with their noise alone")
     args = ap.parse_args()
     cases = CASES
     if args.cases:

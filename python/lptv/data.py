@@ -55,6 +55,9 @@ class FrequencyData:
     :meth:`lptv.DistortionResult.experiments`), else None."""
     realisation = None
     """Its index among that result's realisations, else None."""
+    referred = None
+    """How that result put the nonlinear distortion into these variances: 'output', 'input' or
+    'none' (the noise alone), else None."""
 
     def __init__(self, U, Y, varU, varY, covYU=None, *, w0: float, ts: Optional[float] = None,
                  periods: int = 0):

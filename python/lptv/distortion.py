@@ -251,7 +251,7 @@ class DistortionResult:
         The first fit may be of these experiments, or, where one common level on the outputs
         swamps a weak realisation (a strongly time-varying system whose output power depends on
         the phases; :func:`lptv.identify` then refuses it and says so), of the realisations with
-        their noise alone (``lptv.identify([(u[i], y[i]) for i in range(M)], ...)``). A first
+        their noise alone (``lptv.identify(d.experiments(referred="none"), ...)``). A first
         model whose branches cannot be computed reliably on the lines (a pole on a line, as a fit
         one order short may stop at) is refused with a ``ValueError`` naming ``model``.
 
@@ -260,6 +260,15 @@ class DistortionResult:
         input-referred fit was biased, more so with more realisations, while the fit of the
         realisations with their noise alone and ``covariance="realisations"`` was not; a
         ``UserWarning`` says so (METHOD.md section 16).
+
+        ``referred="none"``: the realisations with their noise alone (each its own P periods'
+        variances, no level added), for that fit: ``lptv.identify(d.experiments(referred="none"),
+        ..., covariance="realisations")`` weighs the lines by the noise, which does not depend on
+        the phases, and takes the parameters' variance, distortion included, from the spread of
+        the leave-one-realisation-out refits. Consistent whatever the HTF's reach; less efficient
+        where the distortion dominates the noise (the weights then ignore it). Its analytic
+        covariance would be the noise's alone, so :func:`lptv.identify` warns when it is asked for
+        one and the distortion is detected.
 
         Examples
         --------
@@ -281,8 +290,15 @@ class DistortionResult:
         >>> bool(z_plain > 10 and abs(z_bla) < 5)   # N(0, 1) if the variances explain the residues
         True
         """
-        if not isinstance(referred, str) or referred not in ("output", "input"):
-            raise ValueError(f"referred must be 'output' or 'input', got {referred!r}")
+        if not isinstance(referred, str) or referred not in ("output", "input", "none"):
+            raise ValueError(f"referred must be 'output', 'input' or 'none', got {referred!r}")
+        if referred == "none":
+            out = []
+            for m, (U, Y, varU, varY, cov) in enumerate(self.spectra):
+                fd = FrequencyData(U, Y, varU, varY, cov, w0=self.w0, ts=self.ts, periods=self.periods)
+                fd.distortion, fd.realisation, fd.referred = self, m, referred
+                out.append(fd)
+            return out
         nl = self.nonlinear_smooth(width)
         if referred == "input":
             if model is None:
@@ -295,7 +311,8 @@ class DistortionResult:
                           + ("referred to the input" if referred == "input" else "on the outputs")
                           + " is no exact noise model there (on the discrete-time example the input-referred fit "
                           "was biased, more so with more realisations); the fit of the realisations with their "
-                          "noise alone and covariance='realisations' is consistent (METHOD.md section 16)",
+                          "noise alone (experiments(referred='none')) and covariance='realisations' is consistent "
+                          "(METHOD.md section 16)",
                           UserWarning, stacklevel=2)
         out = []
         for m, (U, Y, varU, varY, cov) in enumerate(self.spectra):
@@ -305,7 +322,7 @@ class DistortionResult:
             else:
                 fd = FrequencyData(U, Y, varU, varY + nl[:varY.size], cov, w0=self.w0, ts=self.ts, periods=P_eff)
             # so that lptv.identify judges a fit of all M of them by lack_of_fit
-            fd.distortion, fd.realisation = self, m
+            fd.distortion, fd.realisation, fd.referred = self, m, referred
             out.append(fd)
         return out
 
@@ -538,8 +555,8 @@ class DistortionResult:
                        "the phases (far HTF branches of a strongly time-varying system, or a strong nonlinearity); part "
                        "of the level may be branches that "
                        f"{self.realisations} realisations cannot regress, and a level on the outputs or referred to "
-                       "the input is no exact noise model: fit the realisations with their noise alone and "
-                       "covariance='realisations' (METHOD.md section 16)")
+                       "the input is no exact noise model: fit the realisations with their noise alone "
+                       "(experiments(referred='none')) and covariance='realisations' (METHOD.md section 16)")
         return "\n".join(out)
 
 

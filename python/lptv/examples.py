@@ -374,6 +374,111 @@ def system_measurements(system: str = "paper", seed=0, periods: int = 8) -> dict
                 model=model, multisine=ms, structure=structure, lines=lines, noise=noise)
 
 
+# The systems of cubic_realisations: (model factory, excited lines, N, identification rows,
+# structure, keyword arguments of noisy_periods: white noise at these SNRs).
+BLA_SYSTEMS = {
+    "paper": (paper_model, PAPER_EXCITED, PAPER_N, PAPER_ID_LINES, dict(na=2, nb=1, ka=3, kb=3),
+              dict(snr_in_db=50.0, snr_out_db=30.0)),
+    "third_order": (third_order_model, THIRD_ORDER_EXCITED, THIRD_ORDER_N, THIRD_ORDER_ID_LINES,
+                    THIRD_ORDER_STRUCTURE, dict(snr_in_db=40.0, snr_out_db=25.0)),
+    "discrete": (discrete_model, DISCRETE_EXCITED, DISCRETE_N, DISCRETE_ID_LINES, DISCRETE_STRUCTURE,
+                 dict(snr_in_db=45.0, snr_out_db=30.0, correlation=0.3)),
+}
+
+
+def cubic_realisations(system: str = "paper", cubic: float = 0.05, where: str = "input", realisations: int = 6,
+                       periods: int = 4, seed=None) -> dict:
+    """M random-phase realisations x P noisy periods of a test system with a cubic nonlinearity:
+    data for :func:`lptv.distortion` and the best linear time-periodic approximation (BLA).
+
+    ``where='input'``: an actuator before the LPTV system (Hammerstein), x = u + c u^3, whose BLA
+    is the system with its b times the actuator's linear gain (:func:`actuator_gain`): inside the
+    fitted class, known exactly. ``where='output'``: a cubic after it (Wiener), y + c y^3, whose
+    BLA is outside the class. Each realisation: a multisine of flat amplitudes sqrt(2 / L) on the
+    system's excited lines with random phases, then :func:`noisy_periods` with the system's noise
+    (white; 50/30 dB for 'paper', 40/25 dB 'third_order', 45/30 dB with correlation 0.3
+    'discrete'). ``seed``: an int, a sequence or a Generator, drawn from in one order (phases,
+    then noise, realisation by realisation), so that the same seed gives the same data.
+
+    Returns
+    -------
+    dict
+        ``u``, ``y`` (M, P, N); ``model`` (the LPTV part), ``w0``, ``ts``, ``excited``,
+        ``lines`` (identification rows), ``structure`` (na, nb, ka, kb), ``noise`` (the keyword
+        arguments of :func:`noisy_periods`), ``cubic``, ``where``.
+
+    Examples
+    --------
+    >>> import lptv
+    >>> from lptv.examples import cubic_realisations
+    >>> r = cubic_realisations("third_order", cubic=0.05, where="input", realisations=6, periods=8, seed=1)
+    >>> r["u"].shape
+    (6, 8, 1024)
+    >>> bool(lptv.distortion(r["u"], r["y"], w0=r["w0"]).detected)
+    True
+    """
+    if system not in BLA_SYSTEMS:
+        raise ValueError(f"system must be one of {SYSTEMS}, got {system!r}")
+    if not isinstance(where, str) or where not in ("input", "output"):
+        raise ValueError(f"where must be 'input' (an actuator before the system) or 'output', got {where!r}")
+    try:
+        cubic = float(cubic)
+    except (TypeError, ValueError):
+        raise ValueError(f"cubic must be a real number, got {cubic!r}") from None
+    if not np.isfinite(cubic):
+        raise ValueError(f"cubic must be finite, got {cubic!r}")
+    M, P = as_int(realisations, "realisations", minimum=1), as_int(periods, "periods", minimum=1)
+    make, excited, N, lines, structure, noise = BLA_SYSTEMS[system]
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    m = make()
+    u, y = [], []
+    for _ in range(M):
+        ms = multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
+        if where == "input":
+            y0 = time_signal(simulate(m, np.fft.rfft(ms.signal + cubic * ms.signal ** 3) / N), N)
+        else:
+            y0 = time_signal(simulate(m, ms.spectrum), N)
+            y0 = y0 + cubic * y0 ** 3
+        a, b = noisy_periods(ms.signal, y0, P, seed=rng, **noise)
+        u.append(a)
+        y.append(b)
+    return dict(u=np.array(u), y=np.array(y), model=m, w0=m.w0, ts=m.ts, excited=excited, lines=lines,
+                structure=dict(structure), noise=dict(noise), cubic=cubic, where=where)
+
+
+def actuator_gain(system: str = "paper", cubic: float = 0.05, n: int = 400, seed=12345) -> float:
+    """The linear gain g of the actuator x = u + c u^3 for the flat random-phase multisine of
+    :func:`cubic_realisations` (the mean over ``n`` realisations of the cross-spectrum on the
+    excited lines over the input's power): the exact BLA of that Hammerstein system is the LPTV
+    system with b times g (:func:`exact_bla`). Its sampling error falls as 1 / sqrt(n).
+
+    >>> from lptv.examples import actuator_gain
+    >>> round(actuator_gain("third_order", 0.05), 2)
+    1.15
+    """
+    if system not in BLA_SYSTEMS:
+        raise ValueError(f"system must be one of {SYSTEMS}, got {system!r}")
+    _, excited, N, *_ = BLA_SYSTEMS[system]
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    num = den = 0.0
+    for _ in range(as_int(n, "n", minimum=1)):
+        ms = multisine(excited, N, amplitudes=np.sqrt(2 / excited.size), seed=rng)
+        X = np.fft.rfft(ms.signal + cubic * ms.signal ** 3) / N
+        num += np.sum(X[excited] * np.conj(ms.spectrum[excited]))
+        den += np.sum(np.abs(ms.spectrum[excited]) ** 2)
+    return float(np.real(num / den))
+
+
+def exact_bla(system: str = "paper", cubic: float = 0.05, n: int = 400, seed=12345) -> Model:
+    """The exact BLA of the system of :func:`cubic_realisations` behind the actuator
+    x = u + c u^3: the LPTV model with its b times :func:`actuator_gain`."""
+    m = BLA_SYSTEMS[system][0]() if system in BLA_SYSTEMS else None
+    if m is None:
+        raise ValueError(f"system must be one of {SYSTEMS}, got {system!r}")
+    g = actuator_gain(system, cubic, n, seed)
+    return Model(np.array(m.a), np.array(m.b) * g, w0=m.w0, ts=m.ts)
+
+
 def transient_record(model: Model, periods: int = 4, noise_std: float = 0.01, seed=None,
                      state_std: float = 3.0, input_std: float = 1.0):
     """One record of a discrete-time LPTV model under white noise, from a random initial state.

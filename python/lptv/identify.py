@@ -453,6 +453,9 @@ class IdentificationResult:
             dof = self.covariance_dof[self.parameter_std > 0] if np.any(self.parameter_std > 0) else self.covariance_dof
             head = (f" (intervals from the {self.n_experiments} realisations' jackknife, its degrees of freedom "
                     f"{dof.min():.3g}-{dof.max():.3g})")
+        elif lof is not None and getattr(self.experiments[0], "referred", None) == "none":
+            head = (" (analytic intervals of the noise alone, without the nonlinear distortion: "
+                    "covariance='realisations' includes it)")
         elif lof is not None:
             head = (" (analytic intervals take the lines' distortion independent; measured to cover 78-97 % per "
                     "parameter, less with the level referred to the input: covariance='realisations' is calibrated)")
@@ -740,6 +743,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     elif covariance == "realisations":
         cov, cov_dof = _jackknife(r, structure, datas if several else None, rows if several else None, method, tol,
                                   max_iter)
+    if (covariance != "realisations" and several and cov is not None
+            and all(getattr(d, "referred", None) == "none" for d in datas) and datas[0].distortion.detected):
+        warnings.warn("the realisations carry their noise alone (DistortionResult.experiments(referred='none')) and "
+                      "the nonlinear distortion is detected: the analytic covariance is the noise's alone and "
+                      "understates the variance of the best linear approximation; covariance='realisations' "
+                      "includes the distortion", UserWarning, stacklevel=2)
     if cov is not None:
         model.covariance, model.eta_names = np.asarray(cov), tuple(r.eta_names)
     return IdentificationResult(
@@ -980,7 +989,7 @@ def _with_distortion_hint(msg: str, datas) -> str:
             f"output variances; realisation {e}'s output power is {power[e] / max(power):.2g} of the largest "
             f"({min(power) / max(power):.2g} at the least), below that level. A response that depends on the "
             f"phases this much has far HTF branches: fit the realisations with their noise alone and the "
-            f"jackknife over them (lptv.identify([(u[i], y[i]) for i in range(M)], ..., "
+            f"jackknife over them (lptv.identify(d.experiments(referred='none'), ..., "
             f"covariance='realisations')), which is consistent there; or refer the level to the input "
             f"(d.experiments(referred='input', model=that fit)), more efficient where the branches are few")
 

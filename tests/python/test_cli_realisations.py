@@ -158,19 +158,10 @@ def test_referred_input_falls_back_to_a_plain_first_fit_where_the_output_referre
     realisation, so the output-referred first fit is refused; the level is referred through a
     fit of the realisations with their noise alone, as the refusal advises, and the command says
     so. The model is the library's on the same route."""
-    from lptv.examples import DISCRETE_EXCITED, DISCRETE_ID_LINES, DISCRETE_N, DISCRETE_STRUCTURE, discrete_model
+    from lptv.examples import DISCRETE_ID_LINES, DISCRETE_STRUCTURE, cubic_realisations
 
-    m = discrete_model()
-    rng = np.random.default_rng([1, 77])
-    u, y = [], []
-    for _ in range(6):
-        ms = lptv.multisine(DISCRETE_EXCITED, DISCRETE_N, amplitudes=np.sqrt(2 / DISCRETE_EXCITED.size), seed=rng)
-        y0 = lptv.time_signal(lptv.simulate(m, np.fft.rfft(ms.signal + 0.05 * ms.signal ** 3) / DISCRETE_N),
-                              DISCRETE_N)
-        a, b = noisy_periods(ms.signal, y0, 8, 45.0, 30.0, correlation=0.3, seed=rng)
-        u.append(a)
-        y.append(b)
-    u, y = np.array(u), np.array(y)
+    r = cubic_realisations("discrete", 0.05, "input", 6, 8, seed=[1, 77])
+    m, u, y = r["model"], r["u"], r["y"]
     src = tmp_path / "dt.npz"
     np.savez(src, u=u, y=y, w0=m.w0)
     out = tmp_path / "out"
@@ -194,4 +185,23 @@ def test_referred_input_falls_back_to_a_plain_first_fit_where_the_output_referre
     assert np.allclose(model.b, ref.model.b, rtol=1e-9, atol=1e-12)
     assert np.allclose(model.a, ref.model.a, rtol=1e-9, atol=1e-12)
     assert s["covariance_dof"] == pytest.approx(list(ref.covariance_dof), rel=1e-9)
+    # --referred none: the realisations with their noise alone, intervals from the jackknife
+    # (taken whatever --covariance says), as the library's route; its report says which
+    out2 = tmp_path / "none"
+    args2 = [a for a in args[:-1] if a not in ("--covariance", "realisations")] + [str(out2)]
+    args2[args2.index("input")] = "none"
+    assert cli.main(args2) == 0
+    printed = capsys.readouterr().out
+    assert "fitted together with their noise alone" in printed and "jackknife" in printed
+    s2 = json.loads((out2 / "summary.json").read_text())
+    assert s2["referred"] == "none" and s2["covariance"] == "realisations"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref2 = lptv.identify(d.experiments(referred="none"), lines=rows, method="sml", covariance="realisations",
+                             **DISCRETE_STRUCTURE)
+    model2 = lptv.Model.load(out2 / "model.json")
+    assert np.allclose(model2.b, ref2.model.b, rtol=1e-9, atol=1e-12)
+    assert np.allclose(model2.a, ref2.model.a, rtol=1e-9, atol=1e-12)
+    assert s2["covariance_dof"] == pytest.approx(list(ref2.covariance_dof), rel=1e-9)
+    assert "each with its noise alone" in (out2 / "report.html").read_text()
 

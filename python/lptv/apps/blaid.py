@@ -76,7 +76,12 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
             per = lines if isinstance(lines, str) else [lines] * M
             referred = getattr(args, "referred", "output")
             first_fit = None
-            if referred == "input" and dist.detected:
+            if referred == "none":
+                # the realisations with their noise alone; the jackknife over them brings the
+                # distortion into the intervals (the analytic covariance would leave it out)
+                exps = dist.experiments(referred="none")
+                covariance = "realisations"
+            elif referred == "input" and dist.detected:
                 # an actuator's distortion: referred to the input through a first, output-referred
                 # fit; where that is refused (one common level above a weak realisation's output)
                 # or its branches are unreliable, through a fit of the realisations' noise alone
@@ -106,11 +111,17 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                                     ", continuous-time model") + f") -> {out}/")
     print(dist.summary())
     worth = ", ".join(str(e.periods) for e in exps)
+    referred = getattr(args, "referred", "output")
     side = (f"referred to the input (a nonlinearity before the dynamics) through {first_fit or 'a first fit'}"
-            if getattr(args, "referred", "output") == "input" else "added to the output noise")
-    print("model: the best linear approximation, the realisations fitted together with the nonlinear "
-          f"level {side} (their variances worth {worth} periods: the P shown below)"
-          if dist.detected else "model: the realisations fitted together (no nonlinear level to add)")
+            if referred == "input" else "added to the output noise")
+    if referred == "none":
+        print("model: the best linear approximation, the realisations fitted together with their noise alone; "
+              "its intervals from the jackknife over the realisations, which includes the nonlinear distortion "
+              "(--referred none; --covariance is taken as realisations)")
+    else:
+        print("model: the best linear approximation, the realisations fitted together with the nonlinear "
+              f"level {side} (their variances worth {worth} periods: the P shown below)"
+              if dist.detected else "model: the realisations fitted together (no nonlinear level to add)")
     print(res.summary())
     for msg in extra:
         print(f"warning: {msg}")
@@ -141,6 +152,11 @@ def _dof_range(res):
     return f"{dof.min():.3g}-{dof.max():.3g} for {res.n_experiments} realisations"
 
 
+def res_covariance(args, res) -> str:
+    """The covariance the fit reports: --covariance, or the jackknife with --referred none."""
+    return "realisations" if res.covariance_dof is not None else getattr(args, "covariance", "analytic")
+
+
 def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None):
     M, P, N = meas.u.shape
     return {
@@ -153,7 +169,7 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None):
         "iterations": res.iterations, "converged": res.converged, "cost": res.cost,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "parameters": parameter_table(res), "warnings": list(res.warnings) + extra,
-        "covariance": getattr(args, "covariance", "analytic"),
+        "covariance": res_covariance(args, res),
         "referred": getattr(args, "referred", "output"), "first_fit": first_fit,
         "covariance_dof": None if res.covariance_dof is None else [float(v) for v in res.covariance_dof],
     }
@@ -188,10 +204,15 @@ def _report(src, meas, dist, res, summary) -> Report:
             + (summary.get("first_fit") or "a first fit")
             + " (a nonlinearity before the dynamics): the best linear time-periodic approximation."
             if summary.get("referred") == "input" else
+            ", each with its noise alone (the weights), the nonlinear distortion in the intervals through the "
+            "jackknife below: the best linear time-periodic approximation, consistent where the response "
+            "depends on the phases."
+            if summary.get("referred") == "none" else
             ", each output variance raised by the nonlinear level: the best linear time-periodic "
             "approximation, whose covariance includes the nonlinear distortion.")
-           + " Each realisation's raised variance is worth more periods than it has (the P of the summary "
-           "below: the degrees of freedom of noise and level together, METHOD.md section 16)."
+           + ("" if summary.get("referred") == "none" else
+              " Each realisation's raised variance is worth more periods than it has (the P of the summary "
+              "below: the degrees of freedom of noise and level together, METHOD.md section 16).")
            if dist.detected else ".")
         + (" The parameter covariance is the jackknife over the realisations (each left out in turn), "
            "which holds whatever the distortion's correlation across lines, corrected for realisations "
