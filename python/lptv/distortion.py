@@ -305,7 +305,7 @@ class DistortionResult:
                 raise ValueError("model: referred='input' needs a first fit's model (e.g. lptv.identify("
                                  "d.experiments(), ...).model) for the branches that refer the level to the input")
             lu = self.input_level(model, width)
-        if self.detected and self.output_spread > OUTPUT_SPREAD_MAX:
+        if self.depends_on_phases:
             warnings.warn(f"the realisations' output powers differ up to {self.output_spread:.3g} times (a response "
                           "that depends on the phases): the nonlinear level "
                           + ("referred to the input" if referred == "input" else "on the outputs")
@@ -535,6 +535,15 @@ class DistortionResult:
         noise model (METHOD.md section 16)."""
         power = [float(np.sum(np.abs(np.asarray(Y)[1:]) ** 2)) for _, Y, *_ in self.spectra]
         return float(max(power) / max(min(power), 1e-300))
+
+    @property
+    def depends_on_phases(self) -> bool:
+        """The distortion is detected and the realisations' outputs differ more than 4 times
+        (:attr:`output_spread`): neither level (on the outputs, referred to the input) is an
+        exact noise model, and the realisations with their noise alone
+        (``experiments(referred="none")``) with ``covariance="realisations"`` are the consistent
+        fit (METHOD.md section 16). ``lptv identify`` takes that route by itself then."""
+        return bool(self.detected and self.output_spread > OUTPUT_SPREAD_MAX)
 
     def summary(self) -> str:
         ok = np.isfinite(self.p_value)

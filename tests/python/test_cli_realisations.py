@@ -185,16 +185,20 @@ def test_referred_input_falls_back_to_a_plain_first_fit_where_the_output_referre
     assert np.allclose(model.b, ref.model.b, rtol=1e-9, atol=1e-12)
     assert np.allclose(model.a, ref.model.a, rtol=1e-9, atol=1e-12)
     assert s["covariance_dof"] == pytest.approx(list(ref.covariance_dof), rel=1e-9)
-    # --referred none: the realisations with their noise alone, intervals from the jackknife
-    # (taken whatever --covariance says), as the library's route; its report says which
+    # without --referred (auto): these outputs differ more than 4 times, so the realisations
+    # with their noise alone, intervals from the jackknife (taken whatever --covariance says), as
+    # the library's route; --referred none gives the same; the report says which
     out2 = tmp_path / "none"
-    args2 = [a for a in args[:-1] if a not in ("--covariance", "realisations")] + [str(out2)]
-    args2[args2.index("input")] = "none"
+    args2 = [a for a in args[:-1] if a not in ("--covariance", "realisations", "--referred", "input")] + [str(out2)]
     assert cli.main(args2) == 0
     printed = capsys.readouterr().out
-    assert "fitted together with their noise alone" in printed and "jackknife" in printed
+    assert "fitted together with their noise alone" in printed and "--referred auto: chosen" in printed
+    assert "is no exact noise model" not in printed.split("model:")[1]   # no warning about a level not used
     s2 = json.loads((out2 / "summary.json").read_text())
-    assert s2["referred"] == "none" and s2["covariance"] == "realisations"
+    assert s2["referred"] == "none" and s2["covariance"] == "realisations" and s2["referred_option"] == "auto"
+    assert cli.main(args2[:-2] + ["--referred", "none", "--covariance", "analytic", "--out", str(tmp_path / "none2")]) == 0
+    assert "(--referred none; --covariance is taken as realisations)" in capsys.readouterr().out
+    assert (tmp_path / "none2" / "model.json").read_text() == (out2 / "model.json").read_text()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ref2 = lptv.identify(d.experiments(referred="none"), lines=rows, method="sml", covariance="realisations",

@@ -62,7 +62,6 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             dist = distortion(meas.u, meas.y, w0=w0, ts=ts)
-            exps = dist.experiments()
             if lines is None:
                 # Default rows: the excited band, lines K+1 .. (highest excited line + K), where the
                 # linear time-periodic response stands above the distortion; beyond it the output
@@ -72,16 +71,25 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                 # too small and a biased fit.)
                 K = max(np.max(ka), np.max(kb))
                 top = int(np.max(dist.excited)) + K
-                lines = np.arange(K + 1, min(top, exps[0].max_line - K) + 1)
+                lines = np.arange(K + 1, min(top, int(dist.lines[-1]) - K) + 1)
             per = lines if isinstance(lines, str) else [lines] * M
-            referred = getattr(args, "referred", "output")
+            referred = getattr(args, "referred", "auto")
             first_fit = None
+            if referred == "auto":
+                # the level on the outputs, unless the response depends on the phases (far HTF
+                # branches): then the realisations with their noise alone and the jackknife,
+                # the consistent fit there (METHOD.md section 16)
+                referred = "none" if dist.depends_on_phases and M >= 4 else "output"
+                first_fit = (f"chosen: the realisations' output powers differ up to {dist.output_spread:.3g} "
+                             "times" if referred == "none" else None)
             if referred == "none":
                 # the realisations with their noise alone; the jackknife over them brings the
                 # distortion into the intervals (the analytic covariance would leave it out)
                 exps = dist.experiments(referred="none")
                 covariance = "realisations"
-            elif referred == "input" and dist.detected:
+            else:
+                exps = dist.experiments()
+            if referred == "input" and dist.detected:
                 # an actuator's distortion: referred to the input through a first, output-referred
                 # fit; where that is refused (one common level above a weak realisation's output)
                 # or its branches are unreliable, through a fit of the realisations' noise alone
@@ -111,13 +119,16 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                                     ", continuous-time model") + f") -> {out}/")
     print(dist.summary())
     worth = ", ".join(str(e.periods) for e in exps)
-    referred = getattr(args, "referred", "output")
     side = (f"referred to the input (a nonlinearity before the dynamics) through {first_fit or 'a first fit'}"
             if referred == "input" else "added to the output noise")
     if referred == "none":
         print("model: the best linear approximation, the realisations fitted together with their noise alone; "
               "its intervals from the jackknife over the realisations, which includes the nonlinear distortion "
-              "(--referred none; --covariance is taken as realisations)")
+              + ("(--referred none; --covariance is taken as realisations)"
+                 if getattr(args, "referred", "auto") == "none" else
+                 f"(--referred auto: {first_fit}, a response that depends on the phases, where a level on the "
+                 "outputs or referred to the input is no exact noise model; --referred output or input to "
+                 "weigh the level instead)"))
     else:
         print("model: the best linear approximation, the realisations fitted together with the nonlinear "
               f"level {side} (their variances worth {worth} periods: the P shown below)"
@@ -125,7 +136,7 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     print(res.summary())
     for msg in extra:
         print(f"warning: {msg}")
-    summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit)
+    summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit, referred)
     failed = write_fit(out, res.model, summary, lambda: _report(src, meas, dist, res, summary))
     return _fail(failed[0] or src, failed[1]) if failed else 0
 
@@ -157,7 +168,7 @@ def res_covariance(args, res) -> str:
     return "realisations" if res.covariance_dof is not None else getattr(args, "covariance", "analytic")
 
 
-def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None):
+def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None, referred="output"):
     M, P, N = meas.u.shape
     return {
         "file": str(src), "format": meas.format, "realisations": M, "periods": P, "samples_per_period": N,
@@ -170,7 +181,8 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None):
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "parameters": parameter_table(res), "warnings": list(res.warnings) + extra,
         "covariance": res_covariance(args, res),
-        "referred": getattr(args, "referred", "output"), "first_fit": first_fit,
+        "referred": referred, "referred_option": getattr(args, "referred", "auto"),
+        "first_fit": first_fit if referred == "input" else None,
         "covariance_dof": None if res.covariance_dof is None else [float(v) for v in res.covariance_dof],
     }
 
@@ -206,7 +218,9 @@ def _report(src, meas, dist, res, summary) -> Report:
             if summary.get("referred") == "input" else
             ", each with its noise alone (the weights), the nonlinear distortion in the intervals through the "
             "jackknife below: the best linear time-periodic approximation, consistent where the response "
-            "depends on the phases."
+            "depends on the phases"
+            + (f" (chosen by --referred auto: the realisations' output powers differ up to "
+               f"{dist.output_spread:.3g} times)." if summary.get("referred_option") == "auto" else ".")
             if summary.get("referred") == "none" else
             ", each output variance raised by the nonlinear level: the best linear time-periodic "
             "approximation, whose covariance includes the nonlinear distortion.")

@@ -204,12 +204,14 @@ def add_parser(sub):
                    help="the noise variances the fit weighs by: each line's own from its periods (default), "
                    "or moderated across neighbouring lines (smooth noise spectra; more precise estimates and "
                    "calibrated intervals at few periods; one record or --joint)")
-    p.add_argument("--referred", default="output", choices=("output", "input", "none"),
+    p.add_argument("--referred", default="auto", choices=("auto", "output", "input", "none"),
                    help="a record of M x P x N realisations: the nonlinear distortion weighed as output noise "
-                   "(default: a nonlinearity after the dynamics), referred to the input through a first fit "
-                   "(a nonlinearity before them, such as an actuator's), or none: the realisations weighed by "
-                   "their noise alone with intervals from the jackknife over them (consistent where the "
-                   "realisations' output powers differ widely; METHOD.md section 16)")
+                   "(output: a nonlinearity after the dynamics), referred to the input through a first fit "
+                   "(input: a nonlinearity before them, such as an actuator's), or none: the realisations "
+                   "weighed by their noise alone with intervals from the jackknife over them (consistent where "
+                   "the realisations' output powers differ widely). Default auto: none where they differ more "
+                   "than 4 times (a response that depends on the phases), output otherwise (METHOD.md "
+                   "section 16)")
     p.add_argument("--remove-disturbances", action="store_true",
                    help="find the sinusoids that are not periodic in the record (off the period's grid, "
                    "such as mains hum) and subtract them before the fit (lptv.disturbances; one record)")
@@ -310,7 +312,7 @@ def run(args) -> int:
         if args.covariance == "realisations":
             raise FileError("--covariance realisations is for a record of M x P x N random-phase realisations; "
                             "this one holds periods of one realisation")
-        if getattr(args, "referred", "output") != "output":
+        if getattr(args, "referred", "auto") not in ("auto", "output"):
             raise FileError(f"--referred {args.referred} is for a record of M x P x N random-phase realisations; "
                             "this one holds periods of one realisation")
         record = check_record(meas.u, meas.y, warn=False)
