@@ -334,12 +334,20 @@ class IdentificationResult:
     """A prediction error this far above the output noise (dB) rejects the model."""
 
     @property
+    def _noise_alone(self) -> bool:
+        """A fit of DistortionResult.experiments(referred='none') whose distortion is detected."""
+        return bool(self.experiments) and all(getattr(d, "referred", None) == "none" for d in self.experiments) \
+            and self.experiments[0].distortion is not None and self.experiments[0].distortion.detected
+
+    @property
     def model_errors(self) -> Tuple[str, ...]:
         """The signs of a model error, each as a sentence (empty when none): a residue test of
         :attr:`residue_tests` that rejects (for a fit of a DistortionResult's realisations
         :attr:`lack_of_fit` instead; without either, residues outside the predicted band
-        on the excited lines), a cost far above 1, a prediction error far above the noise. Any
-        one rejects the model, whatever the fraction on all rows says."""
+        on the excited lines), a cost far above 1, a prediction error far above the noise (not for
+        realisations weighed by their noise alone, ``referred='none'``, whose cost holds the
+        distortion: the lack of fit alone judges those). Any one rejects the model, whatever the
+        fraction on all rows says."""
         out = []
         lof = self.lack_of_fit
         tests = None if lof is not None else self.residue_tests
@@ -354,6 +362,10 @@ class IdentificationResult:
                 out.append(f"{100 * self.verdict_fraction:.1f} % of the normalised residues on the "
                            f"{self.verdict_lines.size} excited lines are above 0 dB, outside the predicted "
                            f"{100 * lo:.1f}-{100 * hi:.1f} %")
+        if lof is not None and self._noise_alone:
+            # the realisations weighed by their noise alone: cost and prediction error hold the
+            # distortion, which their limits (the noise's) leave out; the lack of fit judges
+            return tuple(out)
         lim = self.cost_limit
         if lim is not None and self.cost > lim:
             out.append(f"the cost {self.cost:.3g} is far above its noise level (limit {lim:.3g})")

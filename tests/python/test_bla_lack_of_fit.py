@@ -424,6 +424,10 @@ def test_the_realisations_with_their_noise_alone():
                               **DISCRETE_STRUCTURE)
         res = lptv.identify(exps, lines=rows, method="sml", covariance="realisations", **DISCRETE_STRUCTURE)
     np.testing.assert_array_equal(res.eta, plain.eta)
+    # judged by the lack of fit alone (the cost and the prediction error hold the distortion:
+    # test_readme's example shows one above its noise's limit)
+    assert res.model_ok and res.verdict.startswith("the model is consistent with the best linear")
+    assert not plain.model_ok        # the same estimate judged as a fit of noise alone
     g = _actuator_gain(DISCRETE_EXCITED, DISCRETE_N, 0.05)
     truth = _eta_of(lptv.Model(np.array(m.a), np.array(m.b) * g, w0=m.w0, ts=m.ts), res.eta_names)
     free = res.parameter_std > 0

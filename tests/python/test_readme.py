@@ -132,6 +132,9 @@ def test_readme_noise_alone_example_runs(tmp_path, monkeypatch):
     d, bla = ns["d"], ns["bla"]
     assert d.depends_on_phases and d.realisations == 12
     assert bla.covariance_dof is not None and not bla.lack_of_fit.rejects
+    # the cost holds the distortion (the weights are the noise's): above its noise limit, yet the
+    # verdict is the lack of fit's
+    assert bla.cost > bla.cost_limit and bla.model_ok
     truth = exact_bla("discrete", 0.05)
     names = bla.eta_names
     free = bla.parameter_std > 0
