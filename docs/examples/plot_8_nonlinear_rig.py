@@ -12,7 +12,7 @@ weighing the distortion can be compared with the truth:
 - on the outputs (``d.experiments()``): right for a nonlinearity after the dynamics;
 - referred to the input through a first fit (``referred="input"``): right for an actuator;
 - the noise alone with the jackknife's intervals (``referred="none"``): consistent on any
-  system, less efficient.
+  system, less efficient; the route for a response that depends on the phases.
 
 All three take their intervals from the jackknife over the realisations
 (``covariance="realisations"``, METHOD.md section 16).
