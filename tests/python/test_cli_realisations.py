@@ -192,7 +192,7 @@ def test_referred_input_falls_back_to_a_plain_first_fit_where_the_output_referre
     args2 = [a for a in args[:-1] if a not in ("--covariance", "realisations", "--referred", "input")] + [str(out2)]
     assert cli.main(args2) == 0
     printed = capsys.readouterr().out
-    assert "fitted together with their noise alone" in printed and "--referred auto: chosen" in printed
+    assert "fitted together with their noise alone" in printed and "--referred auto chose it: the realisations' output powers differ" in printed
     assert "is no exact noise model" not in printed.split("model:")[1]   # no warning about a level not used
     s2 = json.loads((out2 / "summary.json").read_text())
     assert s2["referred"] == "none" and s2["covariance"] == "realisations" and s2["referred_option"] == "auto"

@@ -80,8 +80,8 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
                 # branches): then the realisations with their noise alone and the jackknife,
                 # the consistent fit there (METHOD.md section 16)
                 referred = "none" if dist.depends_on_phases and M >= 4 else "output"
-                first_fit = (f"chosen: the realisations' output powers differ up to {dist.output_spread:.3g} "
-                             "times" if referred == "none" else None)
+                first_fit = (f"the realisations' output powers differ up to {dist.output_spread:.3g} times"
+                             if referred == "none" else None)
             if referred == "none":
                 # the realisations with their noise alone; the jackknife over them brings the
                 # distortion into the intervals (the analytic covariance would leave it out)
@@ -126,7 +126,7 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
               "its intervals from the jackknife over the realisations, which includes the nonlinear distortion "
               + ("(--referred none; --covariance is taken as realisations)"
                  if getattr(args, "referred", "auto") == "none" else
-                 f"(--referred auto: {first_fit}, a response that depends on the phases, where a level on the "
+                 f"(--referred auto chose it: {first_fit}, a response that depends on the phases, where a level on the "
                  "outputs or referred to the input is no exact noise model; --referred output or input to "
                  "weigh the level instead)"))
     else:
