@@ -1,7 +1,8 @@
 """The verdict's tests one by one without a model error, on the sample and on the moderated noise
 variances, paired (the same fits judged both ways).
 
-For each system and P, R realisations of the true structure fitted by WGTLS (the default); the
+For each system and P, R realisations of the true structure fitted by WGTLS (the default; or
+SML with ``--method sml``); the
 verdict (METHOD.md section 7) is formed once on each line's own sample (co)variances
 (``lptv.verdict.MODERATE = False``) and once on the moderated ones (the default). Printed: the
 family's size (any Holm-adjusted p-value below 1 %) with its binomial standard error, and per
@@ -12,6 +13,7 @@ F(2, nu), mean and standard deviation about 1) and how often its own p-value fal
     python bench/python/bench_verdict_tests.py --runs 400 --periods 4 --systems third_order
     python bench/python/bench_verdict_tests.py --runs 300 --periods 8 16 32 --systems discrete third_order
     python bench/python/bench_verdict_tests.py --runs 400 --periods 4 --systems discrete --noise moderated
+    python bench/python/bench_verdict_tests.py --runs 500 --periods 4 8 16 32 --systems paper third_order discrete --method sml
 
 ``--noise moderated`` fits with ``lptv.identify(..., noise='moderated')``; the verdict then reads the
 fit's own moderated variances (judged once).
@@ -34,13 +36,13 @@ from lptv.examples import SYSTEMS, system_measurements  # noqa: E402
 
 
 def one(args):
-    system, P, seed, stream, noise = args
+    system, P, seed, stream, noise, method = args
     rng = np.random.default_rng([seed, P, stream + SYSTEMS.index(system)])
     d = system_measurements(system, seed=rng, periods=P)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], ts=d["ts"], lines=d["lines"],
-                            noise=noise)
+                            noise=noise, method=method)
     out = []
     for moderate in ((False, True) if noise == "sample" else (True,)):
         lptv.verdict.MODERATE = moderate
@@ -58,11 +60,12 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--noise", default="sample", choices=("sample", "moderated"),
                     help="the noise the fits weigh by; 'moderated': judged once, on the fit's own moderation")
+    ap.add_argument("--method", default="wgtls", choices=("wgtls", "sml"), help="the estimator fitted")
     args = ap.parse_args(argv)
-    tasks = [(s, P, i, args.stream, args.noise) for s in args.systems for P in args.periods for i in range(args.runs)]
+    tasks = [(s, P, i, args.stream, args.noise, args.method) for s in args.systems for P in args.periods for i in range(args.runs)]
     with ProcessPoolExecutor(args.workers) as ex:
         rows = [o for chunk in ex.map(one, tasks, chunksize=8) for o in chunk]
-    print(f"# {len(tasks)} realisations, WGTLS weighed by {args.noise} noise, seed stream {args.stream}")
+    print(f"# {len(tasks)} realisations, {args.method.upper()} weighed by {args.noise} noise, seed stream {args.stream}")
     for moderate in ((False, True) if args.noise == "sample" else (True,)):
         sel = [r for r in rows if r[2] == moderate]
         rej = np.array([min(x[3] for x in r[3]) <= lptv.verdict.ALPHA for r in sel], float)
