@@ -32,6 +32,7 @@ from . import _core
 
 ALPHA = 0.01
 """Overall size of the residue tests (Holm's combination)."""
+SML_OWN_WEIGHTS = False   # experiment: SML fits projected with their own (full) weights
 MODERATE = True
 """Judge the residues against noise (co)variances moderated across neighbouring lines
 (:func:`lptv.moderated_noise`, METHOD.md section 7); False: against each line's own sample
@@ -186,7 +187,11 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         order.append(np.array([pos[int(l)] for l in srt]))
         S_blocks.append(np.asarray(like.residue_covariance(theta)))
         err_blocks.append(mo.error_covariance(srt) if nu_line is not None else np.zeros((srt.size, srt.size)))
-        if d_fit is d:
+        if SML_OWN_WEIGHTS and res.method == "sml":   # SML weighs by its full residue covariance
+            Sf = S_blocks[-1] if d_fit is d else np.asarray(
+                _core.ExactLikelihood(d_fit._cpp, par, [int(x) for x in keep]).residue_covariance(theta))
+            wfit.append(np.linalg.inv(Sf))
+        elif d_fit is d:
             wfit.append(np.diag(S_blocks[-1]))
         else:   # WGTLS weighs Re and Im of row l alike, by 2 / var e_l
             wfit.append(np.repeat(np.asarray(_core.residue_variance(d_fit._cpp, par, [int(l) for l in srt],
@@ -228,10 +233,18 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     # With moderated variances S is theirs while Pi keeps the weights the fit used: given those
     # weights (independent of the periods' means for Gaussian noise) this S_r is the residue's
     # first-order covariance.
-    w = 1.0 / np.concatenate(wfit)
-    X = Jc @ np.linalg.pinv((Jc * w[:, None]).T @ Jc)         # Jc (Jc^T W Jc)^-1
-    PiS = X @ ((Jc * w[:, None]).T @ S)                        # Pi S
-    G = (Jc * w[:, None]).T @ S @ (Jc * w[:, None])
+    if wfit[0].ndim == 2:      # full weights per experiment (SML_OWN_WEIGHTS)
+        W = np.zeros((n2, n2))
+        o = 0
+        for B in wfit:
+            W[o:o + B.shape[0], o:o + B.shape[0]] = B
+            o += B.shape[0]
+        WJ = W @ Jc
+    else:
+        WJ = Jc * (1.0 / np.concatenate(wfit))[:, None]
+    X = Jc @ np.linalg.pinv(WJ.T @ Jc)                         # Jc (Jc^T W Jc)^-1
+    PiS = X @ (WJ.T @ S)                                       # Pi S
+    G = WJ.T @ S @ WJ
     Sr = S - PiS - PiS.T + X @ G @ X.T
     m = order.size
     blocks = Sr.reshape(m, 2, m, 2)
