@@ -13,6 +13,7 @@ system, the discrete-time system), number of periods P and method (WGTLS, SML):
 Each rate is given with its binomial standard error sqrt(p (1 - p) / R).
 
     python bench/python/bench_verdict.py --runs 400 --periods 4 8 16 32
+    python bench/python/bench_verdict.py --runs 500 --first-seed 500 --cases true   (the size alone)
 
 ``--noise moderated`` fits with ``lptv.identify(..., noise='moderated')`` (the verdict then reads
 the fit's own moderated variances). ``--sample-variances`` judges the residues against each line's own sample (co)variances (the
@@ -64,13 +65,13 @@ def _structure(case, st):
 
 
 def one(args):
-    system, P, seed, moderate, noise = args
+    system, P, seed, moderate, noise, cases = args
     import lptv.verdict
     lptv.verdict.MODERATE = moderate
     rng = np.random.default_rng([seed, P, SYSTEMS.index(system)])
     out = []
     base = system_measurements(system, seed=rng, periods=P)
-    for case in CASES:
+    for case in cases:
         d = base
         if case == "extra_harmonic":
             m = _extra_harmonic_model(base["model"])
@@ -105,13 +106,19 @@ def main(argv=None):
                     help="the noise the fits weigh by (lptv.identify's noise=)")
     ap.add_argument("--sample-variances", action="store_true",
                     help="judge against the lines' own sample variances (no moderation)")
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds first-seed .. first-seed + runs - 1")
+    ap.add_argument("--cases", nargs="+", default=list(CASES), choices=CASES,
+                    help="the cases fitted (default all; 'true' alone measures the size)")
     args = ap.parse_args(argv)
     moderate = not args.sample_variances
-    tasks = [(s, P, seed, moderate, args.noise) for s in args.systems for P in args.periods for seed in range(args.runs)]
+    cases = tuple(c for c in CASES if c in args.cases)
+    tasks = [(s, P, seed, moderate, args.noise, cases) for s in args.systems for P in args.periods
+             for seed in range(args.first_seed, args.first_seed + args.runs)]
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as ex:
         rows = [r for chunk in ex.map(one, tasks, chunksize=8) for r in chunk]
-    print(f"# {len(tasks)} realisations in {time.time() - t0:.0f} s; R = {args.runs} per cell; "
+    print(f"# {len(tasks)} realisations (seeds {args.first_seed}..{args.first_seed + args.runs - 1}) in "
+          f"{time.time() - t0:.0f} s; R = {args.runs} per cell; "
           f"verdict on {'moderated' if moderate else 'sample'} variances; fits weighed by {args.noise} noise")
     print("| system | P | method | size (true structure) | power: extra 2 % harmonic | power: a0 one harmonic "
           "too few | power: missing order | errors |")
@@ -122,6 +129,9 @@ def main(argv=None):
                 cells, n_err = [], 0
                 for case in CASES:
                     sel = [r for r in rows if r[0] == s and r[1] == P and r[2] == case and r[3] == method]
+                    if not sel:
+                        cells.append("-")
+                        continue
                     rej = np.array([not r[4] for r in sel], float)
                     n_err += sum(r[5].startswith("error") for r in sel)
                     p = rej.mean()
