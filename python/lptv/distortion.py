@@ -295,20 +295,13 @@ class DistortionResult:
         """
         if not isinstance(referred, str) or referred not in ("output", "input", "none"):
             raise ValueError(f"referred must be 'output', 'input' or 'none', got {referred!r}")
-        if referred == "none":
-            out = []
-            for m, (U, Y, varU, varY, cov) in enumerate(self.spectra):
-                fd = FrequencyData(U, Y, varU, varY, cov, w0=self.w0, ts=self.ts, periods=self.periods)
-                fd.distortion, fd.realisation, fd.referred = self, m, referred
-                out.append(fd)
-            return out
-        nl = self.nonlinear_smooth(width)
+        nl = self.nonlinear_smooth(width) if referred != "none" else None
         if referred == "input":
             if model is None:
                 raise ValueError("model: referred='input' needs a first fit's model (e.g. lptv.identify("
                                  "d.experiments(), ...).model) for the branches that refer the level to the input")
             lu = self.input_level(model, width)
-        if self.depends_on_phases:
+        if referred != "none" and self.depends_on_phases:
             warnings.warn(f"the realisations' output powers differ up to {self.output_spread:.3g} times (a response "
                           "that depends on the phases): the nonlinear level "
                           + ("referred to the input" if referred == "input" else "on the outputs")
@@ -319,8 +312,10 @@ class DistortionResult:
                           UserWarning, stacklevel=2)
         out = []
         for m, (U, Y, varU, varY, cov) in enumerate(self.spectra):
-            P_eff = self.effective_periods(varY, nl, width)
-            if referred == "input":
+            P_eff = self.periods if referred == "none" else self.effective_periods(varY, nl, width)
+            if referred == "none":        # the realisation's own periods, nothing added
+                fd = FrequencyData(U, Y, varU, varY, cov, w0=self.w0, ts=self.ts, periods=P_eff)
+            elif referred == "input":
                 fd = FrequencyData(U, Y, varU + lu[:varU.size], varY, cov, w0=self.w0, ts=self.ts, periods=P_eff)
             else:
                 fd = FrequencyData(U, Y, varU, varY + nl[:varY.size], cov, w0=self.w0, ts=self.ts, periods=P_eff)

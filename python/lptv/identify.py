@@ -334,12 +334,6 @@ class IdentificationResult:
     """A prediction error this far above the output noise (dB) rejects the model."""
 
     @property
-    def _noise_alone(self) -> bool:
-        """A fit of DistortionResult.experiments(referred='none') whose distortion is detected."""
-        return bool(self.experiments) and all(getattr(d, "referred", None) == "none" for d in self.experiments) \
-            and self.experiments[0].distortion is not None and self.experiments[0].distortion.detected
-
-    @property
     def model_errors(self) -> Tuple[str, ...]:
         """The signs of a model error, each as a sentence (empty when none): a residue test of
         :attr:`residue_tests` that rejects (for a fit of a DistortionResult's realisations
@@ -362,7 +356,7 @@ class IdentificationResult:
                 out.append(f"{100 * self.verdict_fraction:.1f} % of the normalised residues on the "
                            f"{self.verdict_lines.size} excited lines are above 0 dB, outside the predicted "
                            f"{100 * lo:.1f}-{100 * hi:.1f} %")
-        if lof is not None and self._noise_alone:
+        if lof is not None and _noise_alone(self.experiments):
             # the realisations weighed by their noise alone: cost and prediction error hold the
             # distortion, which their limits (the noise's) leave out; the lack of fit judges
             return tuple(out)
@@ -465,7 +459,7 @@ class IdentificationResult:
             dof = self.covariance_dof[self.parameter_std > 0] if np.any(self.parameter_std > 0) else self.covariance_dof
             head = (f" (intervals from the {self.n_experiments} realisations' jackknife, its degrees of freedom "
                     f"{dof.min():.3g}-{dof.max():.3g})")
-        elif lof is not None and getattr(self.experiments[0], "referred", None) == "none":
+        elif lof is not None and _noise_alone(self.experiments, detected=False):
             head = (" (analytic intervals of the noise alone, without the nonlinear distortion: "
                     "covariance='realisations' includes it)")
         elif lof is not None:
@@ -755,8 +749,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     elif covariance == "realisations":
         cov, cov_dof = _jackknife(r, structure, datas if several else None, rows if several else None, method, tol,
                                   max_iter)
-    if (covariance != "realisations" and several and cov is not None
-            and all(getattr(d, "referred", None) == "none" for d in datas) and datas[0].distortion.detected):
+    if covariance != "realisations" and several and cov is not None and _noise_alone(datas):
         warnings.warn("the realisations carry their noise alone (DistortionResult.experiments(referred='none')) and "
                       "the nonlinear distortion is detected: the analytic covariance is the noise's alone and "
                       "understates the variance of the best linear approximation; covariance='realisations' "
@@ -775,6 +768,13 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
         unstable=unstable, stability_undecided=undecided, structure=structure, noise=noise,
         moderation=moderation, disturbances=found, covariance_dof=cov_dof)
+
+
+def _noise_alone(datas, detected: bool = True) -> bool:
+    """The experiments are DistortionResult.experiments(referred='none') (the realisations with
+    their noise alone), and, with ``detected``, their distortion is detected."""
+    return (bool(datas) and all(getattr(d, "referred", None) == "none" for d in datas)
+            and (not detected or datas[0].distortion.detected))
 
 
 def _without_disturbances(u, y, several):

@@ -137,6 +137,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     (no data kept, no noise, no rows). ``structure`` is the core's Structure of the fit;
     ``excited`` the excited lines of each experiment (default: ``lptv.excited_lines``)."""
     from scipy import stats
+    from scipy.linalg import block_diag
 
     datas = list(res.experiments) if res.experiments else ([res.data] if res.data is not None else [])
     if not datas or res.noise_free or structure is None:
@@ -213,12 +214,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     if not order:
         return None
     order = np.concatenate(order)
-    n2 = 2 * order.size
-    S = np.zeros((n2, n2))
-    o = 0
-    for B in S_blocks:
-        S[o:o + B.shape[0], o:o + B.shape[0]] = B
-        o += B.shape[0]
+    S = block_diag(*S_blocks)
     Jc = np.vstack(J_blocks)
     sd = np.diag(S).copy()
     if not np.all(sd > 0):
@@ -237,12 +233,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     # weights (independent of the periods' means for Gaussian noise) this S_r is the residue's
     # first-order covariance.
     if wfit[0].ndim == 2:      # full weights per experiment (SML_OWN_WEIGHTS)
-        W = np.zeros((n2, n2))
-        o = 0
-        for B in wfit:
-            W[o:o + B.shape[0], o:o + B.shape[0]] = B
-            o += B.shape[0]
-        WJ = W @ Jc
+        WJ = block_diag(*wfit) @ Jc
     else:
         WJ = Jc * (1.0 / np.concatenate(wfit))[:, None]
     X = Jc @ np.linalg.pinv(WJ.T @ Jc)                         # Jc (Jc^T W Jc)^-1

@@ -163,7 +163,7 @@ def _dof_range(res):
     return f"{dof.min():.3g}-{dof.max():.3g} for {res.n_experiments} realisations"
 
 
-def res_covariance(args, res) -> str:
+def _res_covariance(args, res) -> str:
     """The covariance the fit reports: --covariance, or the jackknife with --referred none."""
     return "realisations" if res.covariance_dof is not None else getattr(args, "covariance", "analytic")
 
@@ -180,7 +180,7 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None, 
         "iterations": res.iterations, "converged": res.converged, "cost": res.cost,
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
         "parameters": parameter_table(res), "warnings": list(res.warnings) + extra,
-        "covariance": res_covariance(args, res),
+        "covariance": _res_covariance(args, res),
         "referred": referred, "referred_option": getattr(args, "referred", "auto"),
         "first_fit": first_fit if referred == "input" else None,
         "covariance_dof": None if res.covariance_dof is None else [float(v) for v in res.covariance_dof],
