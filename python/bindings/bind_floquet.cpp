@@ -21,6 +21,16 @@ void bind_floquet(py::module_& m) {
     return lptv::floquet(model, opt);
   }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
         "Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).");
+  py::class_<lptv::ProductRadius>(m, "ProductRadius",
+                                  "The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).")
+      .def_readonly("settled", &lptv::ProductRadius::settled)
+      .def_readonly("rho", &lptv::ProductRadius::rho)
+      .def_readonly("steps", &lptv::ProductRadius::steps)
+      .def_readonly("reason", &lptv::ProductRadius::reason);
+  m.def("product_spectral_radius", &lptv::product_spectral_radius, "model"_a, "first_steps"_a, "max_steps"_a,
+        py::call_guard<py::gil_scoped_release>(),
+        "Monodromy products with first_steps, 2 first_steps, ... steps until two successive spectral radii\n"
+        "differ by less than a tenth of their distance to 1 (lptv.floquet.stability_check's first route).");
   m.def("monodromy", &lptv::monodromy, "model"_a, "steps"_a, py::call_guard<py::gil_scoped_release>(),
         "Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps\n"
         "and Richardson) or of the one-step companion matrices (discrete time).");

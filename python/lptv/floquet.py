@@ -246,25 +246,14 @@ def _lti_unstable_text(model: Model) -> Optional[str]:
 
 
 def _lptv_stability(model: Model) -> Tuple[Optional[str], Optional[str]]:
-    rho_prev, reason = None, None
-    steps = 32
-    while steps <= CHECK_MAX_STEPS:
-        try:
-            Phi = monodromy(model, steps)
-        except _core.NumericalError as err:   # overflow: too few steps for F(t)'s peaks
-            rho_prev, reason = None, str(err)
-            steps *= 2
-            continue
-        rho = float(np.abs(np.linalg.eigvals(Phi)).max()) if np.all(np.isfinite(Phi)) else np.nan
-        if not np.isfinite(rho):
-            rho_prev = None
-        elif rho_prev is not None and abs(rho - rho_prev) < 0.1 * abs(rho - 1.0):
-            if rho > 1.0:
-                return f"the model is unstable (Floquet multiplier of magnitude {rho:.6g} > 1)", None
-            return None, None
-        else:
-            rho_prev = rho
-        steps *= 2
+    # The products in the core (_core.product_spectral_radius): monodromy(model, s) for s = 32,
+    # 64, ... CHECK_MAX_STEPS, each run reused for the next s, until two successive radii settle.
+    pr = _core.product_spectral_radius(model._cpp, 32, CHECK_MAX_STEPS)
+    if pr.settled:
+        if pr.rho > 1.0:
+            return f"the model is unstable (Floquet multiplier of magnitude {pr.rho:.6g} > 1)", None
+        return None, None
+    reason = pr.reason or None
     hill_max = max(1, (CHECK_MAX_HILL // max(model.na, 1) - 1) // 2)
     try:
         f = floquet(model, max_truncation=hill_max)

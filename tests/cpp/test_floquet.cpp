@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "lptv/errors.hpp"
 #include "lptv/floquet.hpp"
@@ -156,4 +158,42 @@ TEST_CASE("floquet refuses a vanishing a_na and reports non-convergence", "[floq
   opt.tol = 0.0;
   REQUIRE_THROWS_AS(lptv::floquet(paper_model(), opt), std::invalid_argument);
   REQUIRE_THROWS_AS(lptv::monodromy(paper_model(), 0), std::invalid_argument);
+}
+
+TEST_CASE("product_spectral_radius: the radii of monodromy(m, s) for doubling s, until they settle", "[floquet]") {
+  // The same sequence by monodromy itself (each s from scratch): the radius reached and the
+  // step count agree, and Hill's method agrees with the radius to its own accuracy.
+  auto by_monodromy = [](const lptv::Model& m, int first, int max_steps) {
+    double prev = std::numeric_limits<double>::quiet_NaN();
+    for (int s = first; s <= max_steps; s *= 2) {
+      const double rho = Eigen::EigenSolver<Eigen::MatrixXd>(lptv::monodromy(m, s), false)
+                             .eigenvalues().cwiseAbs().maxCoeff();
+      if (std::isfinite(prev) && std::abs(rho - prev) < 0.1 * std::abs(rho - 1.0)) return std::make_pair(rho, s);
+      prev = rho;
+    }
+    return std::make_pair(std::numeric_limits<double>::quiet_NaN(), 0);
+  };
+  for (const lptv::Model& m : {paper_model(), mathieu(0.02, 1.0, 0.06, 2.0), mathieu(0.02, 1.0, 0.10, 2.0)}) {
+    const lptv::ProductRadius pr = lptv::product_spectral_radius(m, 32, 4096);
+    const auto [rho, steps] = by_monodromy(m, 32, 4096);
+    REQUIRE(pr.settled);
+    REQUIRE(pr.steps == steps);
+    REQUIRE(pr.rho == Approx(rho).epsilon(1e-13));
+    // (the paper's model: a radius of about 1e-36, where both routes are accurate to about
+    // eps times the norm of the monodromy matrix, not relatively)
+    const double hill = lptv::floquet(m).spectral_radius;
+    CAPTURE(pr.rho, hill);
+    REQUIRE(std::abs(pr.rho - hill) <= 1e-8 * hill + 1e-14);
+  }
+  // Discrete time: the exact product, settled at once.
+  Eigen::MatrixXcd a(2, 3), b(1, 1);
+  a << cd(0.1, 0.05), -0.7, cd(0.1, -0.05), 0.0, 1.0, 0.0;
+  b << 1.0;
+  const lptv::Model dt(a, b, 2 * M_PI / 16, 1.0);
+  const lptv::ProductRadius pd = lptv::product_spectral_radius(dt, 32, 4096);
+  REQUIRE(pd.settled);
+  REQUIRE(pd.steps == 0);
+  REQUIRE(pd.rho == Approx(std::abs(lptv::monodromy(dt, 0)(0, 0))).epsilon(1e-15));
+  REQUIRE_THROWS_AS(lptv::product_spectral_radius(paper_model(), 0, 64), std::invalid_argument);
+  REQUIRE_THROWS_AS(lptv::product_spectral_radius(paper_model(), 64, 32), std::invalid_argument);
 }

@@ -63,4 +63,19 @@ Floquet floquet(const Model& m, const FloquetOptions& opt = FloquetOptions());
 // Throws std::invalid_argument for steps < 1 (continuous time) or a vanishing a_na(t).
 Eigen::MatrixXd monodromy(const Model& m, int steps);
 
+// The spectral radius of the monodromy matrix by products, for a stability check whose cost is
+// bounded before it starts: monodromy(m, s) for s = first_steps, 2 first_steps, ... up to
+// max_steps (each run of 2 s steps reused for the next s), until two successive radii differ by
+// less than a tenth of their distance to 1. `settled` says whether they did; `rho` is the last
+// radius then, `steps` the s it was reached with (0 in discrete time, where the one exact
+// product settles unless its radius is exactly 1), `reason` the last overflow's message.
+// Throws std::invalid_argument for a vanishing a_na(t) or steps out of range.
+struct ProductRadius {
+  bool settled = false;
+  double rho = 0.0;
+  int steps = 0;
+  std::string reason;
+};
+ProductRadius product_spectral_radius(const Model& m, int first_steps, int max_steps);
+
 }  // namespace lptv
