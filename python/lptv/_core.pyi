@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -568,6 +568,22 @@ class Floquet:
     @property
     def truncation(self) -> int:
         ...
+class ProductRadius:
+    """
+    The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).
+    """
+    @property
+    def reason(self) -> str:
+        ...
+    @property
+    def rho(self) -> float:
+        ...
+    @property
+    def settled(self) -> bool:
+        ...
+    @property
+    def steps(self) -> int:
+        ...
 def band_matrix(model: Model, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
 def column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -712,6 +728,11 @@ def monodromy(model: Model, steps: typing.SupportsInt | typing.SupportsIndex) ->
     """
 def multisine_spectrum(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     ...
+def product_spectral_radius(model: Model, first_steps: typing.SupportsInt | typing.SupportsIndex, max_steps: typing.SupportsInt | typing.SupportsIndex) -> ProductRadius:
+    """
+    Monodromy products with first_steps, 2 first_steps, ... steps until two successive spectral radii
+    differ by less than a tenth of their distance to 1 (lptv.floquet.stability_check's first route).
+    """
 def real_column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
 def record_prediction(par: Parametrisation, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex, eta_free: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], c: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], ts: typing.SupportsFloat | typing.SupportsIndex = 0.0, transient_degree: typing.SupportsInt | typing.SupportsIndex = -1) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
