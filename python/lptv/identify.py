@@ -16,6 +16,7 @@ from .model import Model
 from ._validate import as_counts, as_float, as_int, as_lines, as_positive_float
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
+COVARIANCES = ("analytic", "bootstrap", "realisations", "none")
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -105,6 +106,9 @@ class IdentificationResult:
     disturbances: Tuple[object, ...] = field(default_factory=tuple, repr=False, compare=False)
     """disturbances='remove': the :class:`lptv.Disturbance` sinusoids (off the period's grid)
     found in the records and subtracted before the fit; empty otherwise or when none was found."""
+    covariance_option: str = "analytic"
+    """The ``covariance`` argument of the fit: 'analytic', 'bootstrap', 'realisations' or
+    'none' (no covariance computed)."""
 
     @property
     def n_experiments(self) -> int:
@@ -147,9 +151,17 @@ class IdentificationResult:
         if not 0.0 < level < 1.0:
             raise ValueError(f"level must be in (0, 1), got {level!r}")
         if self.covariance is None:
-            raise ValueError(f"method {self.method!r} gives no covariance: use method='wgtls' or 'sml'")
+            raise ValueError(self._no_covariance())
         half = norm.ppf(0.5 + level / 2.0) * self.parameter_std
         return np.column_stack([self.eta - half, self.eta + half])
+
+    def _no_covariance(self) -> str:
+        """Why ``covariance`` is None, for the errors and the summary."""
+        if self.covariance_option == "none":
+            return "no covariance was computed (covariance='none'): fit with covariance='analytic' for intervals"
+        if self.method not in ("wgtls", "sml"):
+            return f"method {self.method!r} gives no covariance: use method='wgtls' or 'sml'"
+        return "the covariance could not be computed (see the warnings)"
 
     @property
     def residue_ok(self) -> bool:
@@ -454,7 +466,9 @@ class IdentificationResult:
         from .parameters import format_parameter_table
 
         if self.covariance is None:
-            head = " (no covariance with this method)"
+            head = (" (no covariance: covariance='none')" if self.covariance_option == "none" else
+                    " (no covariance with this method)" if self.method not in ("wgtls", "sml") else
+                    " (no covariance: see the warnings)")
         elif self.covariance_dof is not None:
             dof = self.covariance_dof[self.parameter_std > 0] if np.any(self.parameter_std > 0) else self.covariance_dof
             head = (f" (intervals from the {self.n_experiments} realisations' jackknife, its degrees of freedom "
@@ -599,7 +613,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     tol, max_iter :
         WGTLS (SML) stops when the relative change of the parameters is below ``tol`` or after
         ``max_iter`` weighted solves (Levenberg-Marquardt steps); ``converged`` says which.
-    covariance : {'analytic', 'bootstrap'}
+    covariance : {'analytic', 'bootstrap', 'realisations', 'none'}
         WGTLS, SML: how ``res.covariance`` is obtained. 'analytic' (default): SML's inverse
         Fisher information; WGTLS's sandwich of its estimating equation to second order in the
         noise (the noise of the Jacobian times that of the residue counts where rows carry
@@ -614,6 +628,10 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         leave-one-out jackknife over the experiments times (E-1)/(E-3) (:func:`realisation_covariance`,
         METHOD.md section 16), which needs no model of how the nonlinear distortion is correlated
         across lines; about E + 1 times the cost of the fit.
+        'none': no covariance (``res.covariance`` None, ``confidence_interval`` refuses): the
+        estimate, its residues and the verdict alone, for many fits whose intervals are not read
+        (a structure search, a Monte Carlo of the estimates); the analytic covariance is about a
+        third of a WGTLS fit's time on the paper's example (bench/RESULTS.md).
     bootstrap : int
         The number of refits for ``covariance='bootstrap'`` (at least 20).
     seed : int, optional
@@ -675,8 +693,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     """
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    if not isinstance(covariance, str) or covariance not in ("analytic", "bootstrap", "realisations"):
-        raise ValueError(f"covariance must be 'analytic', 'bootstrap' or 'realisations', got {covariance!r}")
+    if not isinstance(covariance, str) or covariance not in COVARIANCES:
+        raise ValueError(f"covariance must be one of {COVARIANCES}, got {covariance!r}")
     if not isinstance(noise, str) or noise not in ("sample", "moderated"):
         raise ValueError(f"noise must be 'sample' or 'moderated', got {noise!r}")
     if noise == "moderated" and covariance == "bootstrap":
@@ -689,6 +707,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter")
     several = y is None and isinstance(u, (list, tuple))
+    # the core's analytic covariance only where it is the one reported: the bootstrap and the
+    # jackknife replace it, 'none' skips it (about 1.3 ms of a 3.9 ms WGTLS fit on the paper's example)
+    analytic = covariance == "analytic"
     found = ()
     if disturbances == "remove":
         u, y, found = _without_disturbances(u, y, several)
@@ -717,7 +738,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         rows = _experiment_rows(datas, lines, max(ka_l + kb_l))
         try:
             r = _core.identify_experiments([d._cpp for d in datas], structure, method=method, tol=float(tol),
-                                           max_iter=int(max_iter), rows=rows)
+                                           max_iter=int(max_iter), rows=rows, covariance=analytic)
         except ValueError as e:
             raise ValueError(_with_distortion_hint(str(e), datas)) from None
     else:
@@ -727,7 +748,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
             lines = excited_rows(data, max(ka_l + kb_l))
         rows = [] if lines is None else _rows(lines)
         r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter),
-                           rows=rows)
+                           rows=rows, covariance=analytic)
     for msg in r.warnings:
         unident = r.nearly_unidentifiable and "unidentifiable" in msg
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
@@ -767,7 +788,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
         unstable=unstable, stability_undecided=undecided, structure=structure, noise=noise,
-        moderation=moderation, disturbances=found, covariance_dof=cov_dof)
+        moderation=moderation, disturbances=found, covariance_dof=cov_dof, covariance_option=covariance)
 
 
 def _noise_alone(datas, detected: bool = True) -> bool:

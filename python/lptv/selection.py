@@ -123,11 +123,11 @@ def _data_of(shared) -> FrequencyData:
                          w0=shared["w0"], ts=shared["ts"], periods=shared["periods"])
 
 
-def _fit(shared, na, nb, k, method):
+def _fit(shared, na, nb, k, method, covariance="analytic"):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         res = identify(_data_of(shared), na=na, nb=nb, ka=k, kb=k, lines=shared["lines"], method=method,
-                       tol=shared["tol"], max_iter=shared["max_iter"])
+                       tol=shared["tol"], max_iter=shared["max_iter"], covariance=covariance)
     extra = tuple(str(w.message) for w in caught if str(w.message) not in res.warnings)
     return res, tuple(res.warnings) + extra
 
@@ -135,7 +135,9 @@ def _fit(shared, na, nb, k, method):
 def fit_structure(item, shared) -> dict:
     """One candidate (the task :func:`select` sends out): fit (na, nb, k) by ``method``, score it."""
     na, nb, k, method = item
-    res, warns = _fit(shared, na, nb, k, method)
+    # the score reads the cost and the residues, never the covariance: the chosen structure is
+    # fitted again with it at the end
+    res, warns = _fit(shared, na, nb, k, method, covariance="none")
     n_rows = res.lines.size
     if method == "sml":
         V = 2.0 * n_rows * float(res.cost)          # the exact cost (METHOD.md eq. 17)

@@ -274,6 +274,7 @@ def test_error_when_a_parameter_enters_nothing_names_the_input():
     (dict(known={"c0": 1.0}), "not a coefficient name"),
     (dict(known={"a5": 1.0}), "a5 is not a coefficient of the model"),
     (dict(tol=0.0), "tol must be > 0"),
+    (dict(covariance="no"), r"covariance must be one of \('analytic', 'bootstrap', 'realisations', 'none'\)"),
 ])
 def test_error_bad_arguments(small_periods, kwargs, match):
     u, y = small_periods
@@ -316,3 +317,30 @@ def test_identifiability_warning_blames_over_parametrisation_only():
     assert warned and res.nearly_unidentifiable
     res, warned = fit(na=1, ka=3, kb=3, lines=range(1, 244))
     assert not res.residue_ok and not warned
+
+
+@pytest.mark.parametrize("method", ["wgtls", "sml"])
+def test_covariance_none_skips_the_covariance_and_nothing_else(paper_signals, method):
+    # The same estimate, residues and verdict as the default fit (bit for bit: the covariance
+    # comes after the estimate); no covariance, and the calls that need one say why.
+    u, y = paper_data(paper_signals, seed=21, periods=8)
+    w0 = paper_signals[0].w0
+    kw = dict(na=2, nb=1, ka=3, kb=3, w0=w0, method=method)
+    full = lptv.identify(u, y, **kw)
+    bare = lptv.identify(u, y, covariance="none", **kw)
+    assert full.covariance is not None and full.covariance_option == "analytic"
+    assert bare.covariance is None and bare.parameter_std is None and bare.covariance_option == "none"
+    for name in ("theta", "eta", "residue", "residue_variance", "normalized_residue", "lines"):
+        np.testing.assert_array_equal(getattr(bare, name), getattr(full, name))
+    assert bare.cost == full.cost and bare.iterations == full.iterations
+    assert bare.verdict == full.verdict and bare.model_ok == full.model_ok
+    assert bare.model.covariance is None
+    with pytest.raises(ValueError, match="covariance='none'"):
+        bare.confidence_interval()
+    assert "no covariance: covariance='none'" in bare.summary()
+    # a method without a covariance keeps its own message
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # LS on this model: nearly unidentifiable, said elsewhere
+        ls = lptv.identify(u, y, na=2, nb=1, ka=3, kb=3, w0=w0, method="ls")
+    with pytest.raises(ValueError, match="method 'ls' gives no covariance"):
+        ls.confidence_interval()
