@@ -6,6 +6,8 @@ coefficient (35 free real parameters); rows = lines 1..243; WGTLS to tol = 1e-12
 
 - ``identify``: ``lptv.identify(u, y, ...)`` as a user calls it - spectra and noise statistics
   from the periods, the estimate, then the residue, its variance and the validation figures;
+- ``id none``: the same with ``covariance='none'`` (no covariance: what ``lptv.select``'s
+  candidate fits run);
 - ``core``: ``lptv._core.estimate`` on data and a parametrisation built beforehand (the
   compiled estimator alone, no Python around it);
 - ``reference``: ``lptv.reference.identification`` from the periods - ``frequency_data``,
@@ -63,6 +65,11 @@ def routes(u, y, w0):
                           tol=TOL)
         return np.asarray(r.theta), r.iterations
 
+    def identify_none():
+        r = lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, method="wgtls",
+                          tol=TOL, covariance="none")
+        return np.asarray(r.theta), r.iterations
+
     def core():
         r = _core.estimate(core_data._cpp, core_par, rows, method="wgtls", tol=TOL, max_iter=50)
         return np.asarray(r.theta), r.iterations
@@ -77,7 +84,8 @@ def routes(u, y, w0):
         r = ref.estimate(ref_data, ref_par, np.asarray(rows), method="wgtls", tol=TOL)
         return r["theta"], r["iterations"]
 
-    return {"identify": identify, "core": core, "reference": reference, "ref est": ref_est}
+    return {"identify": identify, "id none": identify_none, "core": core, "reference": reference,
+            "ref est": ref_est}
 
 
 def main(n_seeds: int = 3):
@@ -88,9 +96,9 @@ def main(n_seeds: int = 3):
           " - NumPy's BLAS threads (the core's own BLAS runs single-threaded at this size)")
     print(f"times: the fastest of {ROUNDS} interleaved rounds, calls timed whole; "
           "reference/identify (goal: >= 25x) and ref est/core (goal: >= 20x) are the ratios\n")
-    print(f"{'seed':>4} {'iter':>5} {'identify':>10} {'core':>10} {'reference':>10} {'ref est':>10} "
-          f"{'ref/identify':>12} {'ref est/core':>12} {'identify/core':>13} {'theta diff':>10}")
-    ratios_whole, ratios_core, overhead = [], [], []
+    print(f"{'seed':>4} {'iter':>5} {'identify':>10} {'id none':>10} {'core':>10} {'reference':>10} {'ref est':>10} "
+          f"{'ref/identify':>12} {'ref est/core':>12} {'identify/core':>13} {'none/core':>9} {'theta diff':>10}")
+    ratios_whole, ratios_core, overhead, overhead_none = [], [], [], []
     for seed in range(1, n_seeds + 1):
         m = paper_measurements(seed, periods=8)
         fns = routes(m["u"], m["y"], m["w0"])
@@ -108,15 +116,18 @@ def main(n_seeds: int = 3):
         rw = best["reference"] / best["identify"]
         rc = best["ref est"] / best["core"]
         ic = best["identify"] / best["core"]
+        nc = best["id none"] / best["core"]
         ratios_whole.append(rw)
         ratios_core.append(rc)
         overhead.append(ic)
+        overhead_none.append(nc)
         print(f"{seed:>4} {its:>5} " + " ".join(f"{1e3 * best[n]:>8.2f}ms" for n in fns) +
-              f" {rw:>11.1f}x {rc:>11.1f}x {ic:>12.2f}x {diff:>10.1e}", flush=True)
+              f" {rw:>11.1f}x {rc:>11.1f}x {ic:>12.2f}x {nc:>8.2f}x {diff:>10.1e}", flush=True)
     print(f"\nreference / C++ (goals: >= 25x with lptv.identify, >= 20x with the estimator): {min(ratios_whole):.1f}x .. {max(ratios_whole):.1f}x "
           f"with lptv.identify, {min(ratios_core):.1f}x .. {max(ratios_core):.1f}x with "
           f"_core.estimate alone")
-    print(f"lptv.identify / _core.estimate (goal: <= 1.2x): {min(overhead):.2f}x .. {max(overhead):.2f}x")
+    print(f"lptv.identify / _core.estimate (goal: <= 1.2x): {min(overhead):.2f}x .. {max(overhead):.2f}x; "
+          f"with covariance='none' {min(overhead_none):.2f}x .. {max(overhead_none):.2f}x")
 
 
 def phases(n: int = 200):
