@@ -17,7 +17,10 @@
    array of 128 KB or more (the 8 x 2048 noisy periods, their spectra) is mapped and unmapped
    anew, about 1300 instead of 50 page faults per fit.
    The three must give bit-identical estimates (asserted). The executors take turns for
-   ``rounds`` rounds and each one's fastest round counts (the least disturbed by other work).
+   ``rounds`` rounds and each one's fastest round counts (the least disturbed by other work);
+   the "paired" column is the median over the rounds of each round's serial time over the
+   executor's (one quiet serial round sets every executor's best-rounds ratio; the paired
+   median is what a drift of the machine's speed moves least, as farm-bench pairs its runs).
 2. Per-task overhead: ``lptv.batch.run_tasks`` on n_noop empty tasks, one item per task
    (chunk_size=1), with the study's design as the shared argument (two periods of 2048 samples
    and the fit's settings, as every study task carries): wall time per task. With the default
@@ -157,15 +160,20 @@ def main():
                 if name not in best or wall < best[name]:
                     runs[name], best[name] = mc, wall
                 print(f"   round {len(walls[name])}: {name} {wall:.3f} s (load {load()})", flush=True)
-        print(f"{'executor':34s} {'wall s':>8s} {'fits/min':>9s} {'vs serial':>9s}  {'chunks (last call)':18s} rounds")
+        print(f"{'executor':34s} {'wall s':>8s} {'fits/min':>9s} {'vs serial':>9s} {'paired':>7s}  "
+              f"{'chunks (last call)':18s} rounds")
         for name, ex, kw, workers in executors:
             task_min = lptv.batch.executors.TASK_MIN_DASK if ex.startswith("dask") else None
             plan = ("1 item at a time" if ex == "serial" else
                     " ".join(map(str, chunk_sizes(R, workers, lptv.batch.executors._cost.get(COST_KEY), task_min))))
             ratio = best["serial"] / best[name]
-            print(f"{name:34s} {best[name]:8.3f} {60 * R / best[name]:9.0f} {ratio:8.2f}x  {plan[:18]:18s} "
-                  + " ".join(f"{w:.2f}" for w in walls[name]), flush=True)
-            summary.append((R, name, ratio))
+            # each round's serial time over the executor's in the same round, the median over
+            # the rounds: what a drift of the machine's speed between rounds moves least (one
+            # quiet serial round sets the best-rounds ratio of every executor)
+            paired = float(np.median(np.array(walls["serial"]) / np.array(walls[name])))
+            print(f"{name:34s} {best[name]:8.3f} {60 * R / best[name]:9.0f} {ratio:8.2f}x {paired:6.2f}x  "
+                  f"{plan[:18]:18s} " + " ".join(f"{w:.2f}" for w in walls[name]), flush=True)
+            summary.append((R, name, ratio, paired))
         ref = runs["serial"].estimates["wgtls"]
         for name, mc in runs.items():
             assert np.array_equal(mc.estimates["wgtls"], ref, equal_nan=True), f"{name} differs from serial"
@@ -173,9 +181,9 @@ def main():
         print(f"estimates bit-identical on every executor; {fails} failed fits; "
               f"{runs['serial'].report().splitlines()[1].strip()}")
         t_fit = best["serial"] / R
-    print("\nspeed-up over serial (best rounds):")
+    print("\nspeed-up over serial (best rounds; in brackets the median of the rounds' paired ratios):")
     for R in sizes:
-        print(f"   R = {R:5d}: " + ", ".join(f"{name.strip()} {r:.2f}x" for RR, name, r in summary
+        print(f"   R = {R:5d}: " + ", ".join(f"{name.strip()} {r:.2f}x ({rp:.2f}x)" for RR, name, r, rp in summary
                                            if RR == R and name != "serial"))
     if not n_noop:
         print(f"\nload average at the end: {load()}")
