@@ -16,7 +16,10 @@
    workers' environment, so that glibc returns freed memory to the OS) unset: with it every
    array of 128 KB or more (the 8 x 2048 noisy periods, their spectra) is mapped and unmapped
    anew, about 1300 instead of 50 page faults per fit.
-   The three must give bit-identical estimates (asserted). The executors take turns for
+   A third LocalCluster has Dask's housekeeping slowed (the worker's profiler off, the event
+   loops' tick every 1 s instead of 20 ms, the system and memory monitors every 10 s): what a
+   cluster that runs lptv's fits alone can be configured with (README, "Monte Carlo studies").
+   All must give bit-identical estimates (asserted). The executors take turns for
    ``rounds`` rounds and each one's fastest round counts (the least disturbed by other work);
    the "paired" column is the median over the rounds of each round's serial time over the
    executor's (one quiet serial round sets every executor's best-rounds ratio; the paired
@@ -102,13 +105,22 @@ def main():
     print(f"machine: {os.cpu_count()} cores, load average {load()} at the start")
     import dask
 
-    def start_cluster(trim=True):
+    # Dask's housekeeping on every worker, nanny and scheduler: the worker's profiler samples
+    # every 10 ms, the event loops tick every 20 ms, the system and memory monitors poll every
+    # 0.5 s and 0.1 s (distributed's defaults); all of it shares the 2 cores with the fits here.
+    quiet = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
+             "distributed.admin.system-monitor.interval": "10s",
+             "distributed.worker.memory.monitor-interval": "10s",
+             "distributed.nanny.memory.monitor-interval": "10s"}
+
+    def start_cluster(trim=True, extra=None):
         """A LocalCluster of 2 workers x 1 thread (Dask's default worker environment, or with
         MALLOC_TRIM_THRESHOLD_ unset) and its client, warmed by a 4-run study. A nanny writes its
         pre-spawn environment into this process's os.environ, where the process pool's workers
         would find it: it is put back."""
         env = dict(os.environ)
         cfg = {} if trim else {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+        cfg.update(extra or {})
         t0 = time.perf_counter()
         with dask.config.set(cfg):
             cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
@@ -140,7 +152,8 @@ def main():
     executors = (("serial", "serial", {}, 1), ("2 processes (pool per call)", "processes", {"workers": 2, "per_call": True}, 2),
                  ("2 processes (pool kept)", "processes", {"workers": 2}, 2),
                  ("Dask LocalCluster 2 workers", "dask", {}, 2),
-                 ("  the same, malloc trim unset", "dask, trim unset", {}, 2))
+                 ("  the same, malloc trim unset", "dask, trim unset", {}, 2),
+                 ("  the same, housekeeping slowed", "dask, quiet", {}, 2))
     summary = []
     for R in sizes:
         # 1. throughput, side by side in one run
@@ -150,11 +163,15 @@ def main():
         for _ in range(rounds):
             for name, ex, kw, workers in executors:
                 if ex.startswith("dask"):
-                    cluster, client, _ = start_cluster(ex == "dask")
+                    cluster, client, _ = start_cluster(ex != "dask, trim unset", quiet if ex == "dask, quiet" else None)
                     mc, wall = timed(client, R, **kw)
                     client.close()
                     cluster.close()
                 else:
+                    if ex == "serial":
+                        # the serial row without the kept pool forked from this process in the
+                        # round before (its workers share this process's pages until written)
+                        shutdown_pool()
                     mc, wall = timed(ex, R, **kw)
                 walls[name].append(wall)
                 if name not in best or wall < best[name]:
