@@ -106,12 +106,12 @@ def main():
     import dask
 
     # Dask's housekeeping on every worker, nanny and scheduler: the worker's profiler samples
-    # every 10 ms, the event loops tick every 20 ms, the system and memory monitors poll every
-    # 0.5 s and 0.1 s (distributed's defaults); all of it shares the 2 cores with the fits here.
+    # every 10 ms, the event loops tick every 20 ms, the system and memory monitors (the
+    # worker's and its nanny's) poll every 0.5 s and 0.1 s (distributed's defaults); all of it
+    # shares the 2 cores with the fits here.
     quiet = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
              "distributed.admin.system-monitor.interval": "10s",
-             "distributed.worker.memory.monitor-interval": "10s",
-             "distributed.nanny.memory.monitor-interval": "10s"}
+             "distributed.worker.memory.monitor-interval": "10s"}
 
     def start_cluster(trim=True, extra=None):
         """A LocalCluster of 2 workers x 1 thread (Dask's default worker environment, or with
