@@ -106,6 +106,21 @@ def test_identify_many_is_bit_identical_everywhere_and_reports_failures_in_their
     assert [(r["ok"], r["converged"]) for r in slow.rows] == [(True, False), (True, False)]
 
 
+
+def test_identify_many_without_covariance_gives_the_same_estimates_and_no_std():
+    recs = {f"seed {s}": paper_measurements(seed=s, periods=4) for s in (1, 2)}
+    kw = dict(PAPER_KW, w0=0.04, executor="serial", progress=False)
+    full = lptv.identify_many(recs, **kw)
+    bare = lptv.identify_many(recs, covariance="none", **kw)
+    for a, b in zip(full.rows, bare.rows):
+        assert a["ok"] and b["ok"]
+        assert [a[n] for n in full.eta_names] == [b[n] for n in bare.eta_names]
+        assert all(a[n + ".std"] > 0 for n in full.eta_names if n != "a2.re0")
+        assert all(b[n + ".std"] is None for n in bare.eta_names)
+    with pytest.raises(ValueError, match=r"covariance must be one of .*each record is fitted alone.*'realisations'"):
+        lptv.identify_many(recs, covariance="realisations", **kw)
+
+
 # ------------------------------------------------------------------------------ failures
 
 def test_montecarlo_reports_failed_fits_and_realisations_in_their_rows(monkeypatch):

@@ -12,7 +12,7 @@ from typing import Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_positive_float
-from ..identify import METHODS, _counts, _known_list, _rows, identify
+from ..identify import COVARIANCES, METHODS, _counts, _known_list, _rows, identify
 from ..atomic import atomic_open, atomic_path
 from ..measurements import Measurements, read_measurements, read_options
 from ..model import Model
@@ -187,7 +187,7 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
                   ts: Optional[float] = None, lines=None, method: str = "wgtls",
                   known: Optional[Mapping] = None, tol: float = 1e-10, max_iter: int = 50,
                   periods: Optional[int] = None, read: Optional[Mapping] = None,
-                  names: Optional[Sequence[str]] = None,
+                  names: Optional[Sequence[str]] = None, covariance: str = "analytic",
                   executor="processes", workers: Optional[int] = None,
                   chunk_size: Optional[int] = None, progress: Optional[bool] = None,
                   checkpoint=None) -> BatchResult:
@@ -216,6 +216,9 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
         ``dict(u="force", y="disp", period=10.0)`` (channels by name, fs, trim ...).
     names : sequence of str, optional
         Row labels (default: the file paths, or 'record i').
+    covariance : {'analytic', 'bootstrap', 'none'}
+        As for :func:`lptv.identify`, for every record. 'none' leaves the ``.std`` columns empty
+        and saves about a third of each WGTLS fit's time when only the estimates are wanted.
     executor, workers, chunk_size, progress :
         Where and how the fits run (:func:`lptv.batch.run_tasks`).
     checkpoint : str or Path, optional
@@ -243,6 +246,10 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    one_record = tuple(c for c in COVARIANCES if c != "realisations")   # each record is one data set
+    if not isinstance(covariance, str) or covariance not in one_record:
+        raise ValueError(f"covariance must be one of {one_record} (each record is fitted alone), "
+                         f"got {covariance!r}")
     na, nb = as_int(na, "na"), as_int(nb, "nb")
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     _known_list(known, ka_l, kb_l)
@@ -260,6 +267,8 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     settings = dict(w0=w0, ts=ts, periods=periods, read=read,
                     fit=dict(na=na, nb=nb, ka=ka_l, kb=kb_l, lines=lines, method=method, known=known,
                              tol=float(tol), max_iter=max_iter))
+    if covariance != "analytic":   # the settings of earlier checkpoints stay as they were
+        settings["fit"]["covariance"] = covariance
     t0 = time.perf_counter()
     out = run_tasks(identify_record, [(n, _slim(r)) for n, r in zip(names, recs)], settings, executor=executor,
                     workers=workers, chunk_size=chunk_size, progress=progress, desc="identify",
