@@ -630,8 +630,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         across lines; about E + 1 times the cost of the fit.
         'none': no covariance (``res.covariance`` None, ``confidence_interval`` refuses): the
         estimate, its residues and the verdict alone, for many fits whose intervals are not read
-        (a structure search, a Monte Carlo of the estimates); the analytic covariance is about a
-        third of a WGTLS fit's time on the paper's example (bench/RESULTS.md).
+        (a structure search, a Monte Carlo of the estimates); the analytic covariance takes about
+        40 % of a WGTLS fit's time on the paper's example (bench/RESULTS.md).
     bootstrap : int
         The number of refits for ``covariance='bootstrap'`` (at least 20).
     seed : int, optional
@@ -708,7 +708,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     max_iter = as_int(max_iter, "max_iter")
     several = y is None and isinstance(u, (list, tuple))
     # the core's analytic covariance only where it is the one reported: the bootstrap and the
-    # jackknife replace it, 'none' skips it (about 1.3 ms of a 3.9 ms WGTLS fit on the paper's example)
+    # jackknife replace it, 'none' skips it (about 1.6 ms of a 3.9 ms WGTLS fit on the paper's example)
     analytic = covariance == "analytic"
     found = ()
     if disturbances == "remove":
