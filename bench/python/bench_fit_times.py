@@ -1,0 +1,45 @@
+"""The fit's times on the paper's example, for side-by-side runs of two builds under farm-bench.
+
+Prints one line: the fastest of 7 rounds of 40 calls, per call, of ``_core.estimate`` (WGTLS,
+on spectra built beforehand), ``lptv.identify`` (WGTLS from the periods, as a user calls it)
+and ``_core.estimate`` (SML). Seed 1 of ``lptv.examples.paper_measurements`` (P = 8), lines
+1..243, tol 1e-12. To compare two builds, append each one's lines to a file of its own:
+
+    OPENBLAS_NUM_THREADS=1 farm-bench -n 5 \\
+        --vs "sh -c 'exec OLD/.venv/bin/python bench/python/bench_fit_times.py >> /tmp/B.txt 2>&1'" \\
+        -- sh -c 'PYTHONPATH=python exec .venv/bin/python bench/python/bench_fit_times.py >> /tmp/A.txt 2>&1'
+"""
+import time
+
+import lptv
+from lptv import _core
+from lptv.data import FrequencyData
+from lptv.examples import paper_measurements
+
+ROUNDS, CALLS, TOL = 7, 40, 1e-12
+
+
+def main():
+    m = paper_measurements(1, periods=8)
+    u, y, w0 = m["u"], m["y"], m["w0"]
+    data = FrequencyData.from_periods(u, y, w0=w0)
+    par = _core.Parametrisation(2, 1, [3] * 3, [3] * 2, [], w0, 0.0)
+    rows = list(range(1, 244))
+    kw = dict(na=2, nb=1, ka=3, kb=3, w0=w0, lines=range(1, 244), tol=TOL)
+    routes = {
+        "core": lambda: _core.estimate(data._cpp, par, rows, method="wgtls", tol=TOL, max_iter=50),
+        "identify": lambda: lptv.identify(u, y, **kw),
+        "sml core": lambda: _core.estimate(data._cpp, par, rows, method="sml", tol=TOL, max_iter=50),
+    }
+    best = {k: float("inf") for k in routes}
+    for _ in range(ROUNDS):
+        for k, call in routes.items():
+            t0 = time.perf_counter()
+            for _ in range(CALLS):
+                call()
+            best[k] = min(best[k], (time.perf_counter() - t0) / CALLS)
+    print(" ".join(f"{k} {1e3 * v:.3f} ms" for k, v in best.items()))
+
+
+if __name__ == "__main__":
+    main()
