@@ -136,7 +136,7 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
           for (int b = 0; b < 4; ++b) s += C[a][b] * en.G[c][b];
           en.H[a][c] = s;
         }
-      const cd v = A[K_ + k] * X.Y(i) - B[K_ + k] * X.U(i);
+      const cd v = mul(A[K_ + k], X.Y(i)) - mul(B[K_ + k], X.U(i));
       f.r[2 * r] += v.real();
       f.r[2 * r + 1] += v.imag();
     }

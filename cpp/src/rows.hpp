@@ -24,6 +24,13 @@ struct Lines {
   cd covYU(int l) const { return l >= 0 ? d.covYU[l] : std::conj(d.covYU[-l]); }
 };
 
+// a b by the textbook formula, without the NaN recovery of std::complex's operator* (a test
+// of every product's result and, on NaN, a library call); the same bits where the product is
+// finite (no contraction: -ffp-contract=off). What the per-row inner loops multiply with.
+inline cd mul(cd a, cd b) {
+  return cd(a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real());
+}
+
 // Row l of the Jacobian, J[l, q] = +s_{l-k}^n Y_{l-k} (a-parameters), -s_{l-k}^n U_{l-k}
 // (b-parameters), from the row's powers (pw.compute(l) done).
 inline void jacobian_row(const Parametrisation& p, const Lines& X, const RowPowers& pw, int l, cd* out) {
@@ -31,15 +38,8 @@ inline void jacobian_row(const Parametrisation& p, const Lines& X, const RowPowe
     const Param& pr = p.params()[q];
     const int i = l - pr.k;
     const cd f = pw(pr.k, pr.order);
-    out[q] = pr.is_a ? f * X.Y(i) : -f * X.U(i);
+    out[q] = pr.is_a ? mul(f, X.Y(i)) : mul(-f, X.U(i));
   }
-}
-
-// a b by the textbook formula, without the NaN recovery of std::complex's operator* (a test
-// of every product's result and, on NaN, a library call); the same bits where the product is
-// finite (no contraction: -ffp-contract=off). What the per-row inner loops multiply with.
-inline cd mul(cd a, cd b) {
-  return cd(a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real());
 }
 
 // Nonzeros of Text (theta = Text xi): theta_p contributes v to xi column c. One or two per row.
@@ -90,7 +90,7 @@ inline void jacobian_text_row(const Parametrisation& p, const Lines& X, const Ro
   jrow.resize(static_cast<size_t>(p.n_theta()));
   jacobian_row(p, X, pw, l, jrow.data());
   std::fill(xrow, xrow + p.n_xi(), cd(0.0, 0.0));
-  for (const TextEntry& e : text) xrow[e.c] += jrow[static_cast<size_t>(e.p)] * e.v;
+  for (const TextEntry& e : text) xrow[e.c] += mul(jrow[static_cast<size_t>(e.p)], e.v);
 }
 
 // The entries of C_l = E{dJ_l^H dJ_l} that can be nonzero: for each harmonic k (group[K + k],
