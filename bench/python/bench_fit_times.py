@@ -3,12 +3,16 @@
 Prints one line: the fastest of 7 rounds of 40 calls, per call, of ``_core.estimate`` (WGTLS,
 on spectra built beforehand), ``lptv.identify`` (WGTLS from the periods, as a user calls it)
 and ``_core.estimate`` (SML). Seed 1 of ``lptv.examples.paper_measurements`` (P = 8), lines
-1..243, tol 1e-12. To compare two builds, append each one's lines to a file of its own:
+1..243, tol 1e-12. With ``--lti``: the 4th-order LTI case of bench_ml_lti.py (500 lines, P = 8),
+``_core.estimate`` (SML) and ``lptv.identify`` on its spectra (SML), as that bench calls them.
+To compare two builds, append each one's lines to a file of its own:
 
     OPENBLAS_NUM_THREADS=1 farm-bench -n 5 \\
         --vs "sh -c 'exec OLD/.venv/bin/python bench/python/bench_fit_times.py >> /tmp/B.txt 2>&1'" \\
         -- sh -c 'PYTHONPATH=python exec .venv/bin/python bench/python/bench_fit_times.py >> /tmp/A.txt 2>&1'
 """
+import os
+import sys
 import time
 
 import lptv
@@ -19,7 +23,23 @@ from lptv.examples import paper_measurements
 ROUNDS, CALLS, TOL = 7, 40, 1e-12
 
 
+def lti_routes():
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import bench_ml_lti as b
+
+    _, _, data = b.make_case()
+    par = _core.Parametrisation(4, 0, [0] * 5, [0], [], b.W0, 0.0)
+    kw = dict(na=4, nb=0, lines=b.LINES, method="sml")
+    return {
+        "lti sml core": lambda: _core.estimate(data._cpp, par, b.LINES, method="sml"),
+        "lti identify": lambda: lptv.identify(data, **kw),
+    }
+
+
 def main():
+    if "--lti" in sys.argv[1:]:
+        report(lti_routes())
+        return
     m = paper_measurements(1, periods=8)
     u, y, w0 = m["u"], m["y"], m["w0"]
     data = FrequencyData.from_periods(u, y, w0=w0)
@@ -31,6 +51,10 @@ def main():
         "identify": lambda: lptv.identify(u, y, **kw),
         "sml core": lambda: _core.estimate(data._cpp, par, rows, method="sml", tol=TOL, max_iter=50),
     }
+    report(routes)
+
+
+def report(routes):
     best = {k: float("inf") for k in routes}
     for _ in range(ROUNDS):
         for k, call in routes.items():
