@@ -151,17 +151,19 @@ class IdentificationResult:
         if not 0.0 < level < 1.0:
             raise ValueError(f"level must be in (0, 1), got {level!r}")
         if self.covariance is None:
-            raise ValueError(self._no_covariance())
+            raise ValueError(self._no_covariance()[0])
         half = norm.ppf(0.5 + level / 2.0) * self.parameter_std
         return np.column_stack([self.eta - half, self.eta + half])
 
-    def _no_covariance(self) -> str:
-        """Why ``covariance`` is None, for the errors and the summary."""
+    def _no_covariance(self) -> Tuple[str, str]:
+        """Why ``covariance`` is None: (the error's message, the summary's note)."""
         if self.covariance_option == "none":
-            return "no covariance was computed (covariance='none'): fit with covariance='analytic' for intervals"
+            return ("no covariance was computed (covariance='none'): fit with covariance='analytic' for intervals",
+                    "no covariance: covariance='none'")
         if self.method not in ("wgtls", "sml"):
-            return f"method {self.method!r} gives no covariance: use method='wgtls' or 'sml'"
-        return "the covariance could not be computed (see the warnings)"
+            return (f"method {self.method!r} gives no covariance: use method='wgtls' or 'sml'",
+                    "no covariance with this method")
+        return "the covariance could not be computed (see the warnings)", "no covariance: see the warnings"
 
     @property
     def residue_ok(self) -> bool:
@@ -466,9 +468,7 @@ class IdentificationResult:
         from .parameters import format_parameter_table
 
         if self.covariance is None:
-            head = (" (no covariance: covariance='none')" if self.covariance_option == "none" else
-                    " (no covariance with this method)" if self.method not in ("wgtls", "sml") else
-                    " (no covariance: see the warnings)")
+            head = f" ({self._no_covariance()[1]})"
         elif self.covariance_dof is not None:
             dof = self.covariance_dof[self.parameter_std > 0] if np.any(self.parameter_std > 0) else self.covariance_dof
             head = (f" (intervals from the {self.n_experiments} realisations' jackknife, its degrees of freedom "

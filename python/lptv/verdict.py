@@ -32,7 +32,9 @@ from . import _core
 
 ALPHA = 0.01
 """Overall size of the residue tests (Holm's combination)."""
-SML_OWN_WEIGHTS = True   # SML fits projected with their own weights (their full residue covariance)
+SML_OWN_WEIGHTS = True
+"""Project the residues of an SML fit with its own weights (its full residue covariance);
+False: with WGTLS's diagonal weights (METHOD.md section 7)."""
 MODERATE = True
 """Judge the residues against noise (co)variances moderated across neighbouring lines
 (:func:`lptv.moderated_noise`, METHOD.md section 7); False: against each line's own sample
