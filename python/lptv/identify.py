@@ -795,7 +795,7 @@ def _noise_alone(datas, detected: bool = True) -> bool:
     """The experiments are DistortionResult.experiments(referred='none') (the realisations with
     their noise alone), and, with ``detected``, their distortion is detected."""
     return (bool(datas) and all(getattr(d, "referred", None) == "none" for d in datas)
-            and (not detected or datas[0].distortion.detected))
+            and (not detected or (datas[0].distortion is not None and datas[0].distortion.detected)))
 
 
 def _without_disturbances(u, y, several):
