@@ -249,3 +249,90 @@ def test_a_lost_scheduler_ends_the_study_keeping_the_finished_chunks(tmp_path):
     assert r.returncode == 0 and f"resuming: {kept} of {RUNS}" in r.stdout, r.stderr
     with open(out / "fits.csv") as f:
         assert sum(row["ok"] == "True" for row in csv.DictReader(f)) == RUNS
+
+
+# ------------------------------------------------------------------------------ records that change
+
+def _records(folder, seeds, scale=None):
+    files = []
+    folder.mkdir(parents=True, exist_ok=True)
+    for s in seeds:
+        d = paper_measurements(seed=s, periods=4)
+        y = d["y"] * (scale.get(s, 1.0) if scale else 1.0)
+        files.append(str(folder / f"rec{s}.npz"))
+        np.savez(files[-1], u=d["u"], y=y, w0=d["w0"])
+    return files
+
+
+FIT = ["--na", "2", "--nb", "1", "--ka", "3", "--kb", "3", "--lines", "1-243", "--workers", "1"]
+
+
+def test_a_finished_batch_refits_the_records_that_changed_and_nothing_else(tmp_path, capsys):
+    """A record rewritten after its fit (y * 3) is fitted again on the same command, alone; the
+    table is the one a fresh batch of the new files gives, byte for byte."""
+    files = _records(tmp_path / "recs", range(1, 5))
+    out = tmp_path / "b"
+    assert cli.main(["identify", *files, *FIT, "--out", str(out)]) == 0
+    first = (out / "results.csv").read_text()
+    _records(tmp_path / "recs", [2], scale={2: 3.0})          # rec2.npz rewritten with y * 3
+    before = set((out / "parts").glob("part-*.json"))
+    capsys.readouterr()
+    assert cli.main(["identify", *files, *FIT, "--out", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    assert "resuming: 3 of 4 files are fitted" in stdout
+    assert "1 of 4 files changed since their fits: refitting them" in stdout
+    new = set((out / "parts").glob("part-*.json")) - before
+    assert [json.loads(p.read_text())["labels"] for p in new] == [[files[1]]]      # that file alone
+    assert (out / "results.csv").read_text() != first
+    assert cli.main(["identify", *files, *FIT, "--out", str(tmp_path / "fresh")]) == 0
+    assert (out / "results.csv").read_bytes() == (tmp_path / "fresh" / "results.csv").read_bytes()
+    with open(out / "results.csv") as f:
+        b0 = {r["record"]: float(r["b0.re0"]) for r in csv.DictReader(f)}
+    assert b0[files[1]] == pytest.approx(3 * b0[files[0]], rel=0.1)   # the new contents' fit
+
+
+def test_resume_after_an_interruption_refits_a_record_changed_meanwhile(tmp_path, capsys):
+    files = _records(tmp_path / "recs", range(1, 5))
+    out = tmp_path / "b"
+    assert cli.main(["identify", *files, *FIT, "--out", str(out)]) == 0
+    (out / "results.csv").unlink()
+    _records(tmp_path / "recs", [1], scale={1: 3.0})
+    capsys.readouterr()
+    assert cli.main(["identify", *files, *FIT, "--out", str(out), "--resume"]) == 0
+    assert "1 of 4 files changed since their fits: refitting them" in capsys.readouterr().out
+    assert cli.main(["identify", *files, *FIT, "--out", str(tmp_path / "fresh")]) == 0
+    assert (out / "results.csv").read_bytes() == (tmp_path / "fresh" / "results.csv").read_bytes()
+
+
+def test_a_file_that_changes_while_the_batch_runs_fails_its_row(tmp_path):
+    """The worker compares the bytes it read with the digest the batch was planned with."""
+    from lptv.batch.records import file_digest, identify_record
+
+    files = _records(tmp_path / "recs", [1])
+    item = (files[0], files[0], file_digest(files[0]))
+    _records(tmp_path / "recs", [1], scale={1: 2.0})           # rewritten after planning
+    settings = dict(w0=None, ts=None, periods=None, read={}, fit={})
+    with pytest.raises(ValueError, match="the file changed while the batch ran"):
+        identify_record(item, settings)
+
+
+def test_model_names_are_unique_and_stable_for_colliding_stems(tmp_path, capsys):
+    """a/rec.npz, b/rec.npz and rec-2.npz: three files, three models, whatever the order."""
+    a, b, c2 = (str(tmp_path / "a" / "rec.npz"), str(tmp_path / "b" / "rec.npz"), str(tmp_path / "rec-2.npz"))
+    for f, made in zip((a, b, c2), (_records(tmp_path / "a", [1]), _records(tmp_path / "b", [2]),
+                                    _records(tmp_path, [3]))):
+        os.replace(made[0], f)
+    names = {}
+    for order, out in (([a, b, c2], "o1"), ([c2, b, a], "o2")):
+        assert cli.main(["identify", *order, *FIT, "--out", str(tmp_path / out)]) == 0
+        summary = json.loads((tmp_path / out / "summary.json").read_text())
+        assert len(set(summary["models"].values())) == 3
+        assert len(list((tmp_path / out / "models").glob("*.json"))) == 3
+        names[out] = summary["models"]
+        for f, m in summary["models"].items():     # each model is its own file's fit
+            fitted = lptv.Model.load(tmp_path / out / m)
+            ref = lptv.Model.load(tmp_path / "o1" / names["o1"][f])
+            np.testing.assert_array_equal(fitted.a, ref.a)
+    assert names["o1"] == names["o2"]
+    assert names["o1"][c2] == "models/rec-2.json"
+    assert names["o1"][a] != names["o1"][b] and names["o1"][a].startswith("models/rec-")

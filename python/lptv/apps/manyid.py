@@ -4,8 +4,9 @@ The options are those of ``lptv identify FILE`` (:mod:`lptv.apps.fileid`), the s
 file. The fits run on local processes (``--workers``, default all cores; 1 runs them here) or on
 a Dask cluster (``--scheduler``: the files are read by the workers, so their paths must exist
 there). Writes ``results.csv`` (one row per file: the verdict, the parameters and their std,
-or the error message), ``models/<file stem>.json`` for each file that was fitted and
-``summary.json``; prints one line per file. Exit status 0 when every file was fitted, 1 when
+or the error message), ``models/<name>.json`` for each file that was fitted (the file's stem, with a hash of its
+path when two files of the batch share the stem) and ``summary.json`` (which also maps each file
+to its model); prints one line per file. Exit status 0 when every file was fitted, 1 when
 some failed (their rows say why), 2 for bad options.
 
 Example::
@@ -14,6 +15,7 @@ Example::
 """
 from __future__ import annotations
 
+import os
 import signal
 import sys
 from pathlib import Path
@@ -57,13 +59,33 @@ def executor_of(args):
 
 
 def _stems(files):
-    """Unique file names for the models: the stem, with -2, -3 ... when two files share it."""
-    seen, out = {}, []
+    """Unique, stable names for the models: a file's stem where no other file of the batch has
+    it (up to case, for file systems that ignore it), else the stem and the first hex digits of
+    a hash of the file's absolute path (``rec-3f2a91c0``): the same file gets the same name in
+    every batch it is part of, and two files never share one. A file given twice gets one name."""
+    import hashlib
+
+    def hashed(f, digits):
+        path = os.path.abspath(os.fspath(f))
+        return f"{Path(f).stem}-{hashlib.sha256(path.encode('utf-8', 'surrogateescape')).hexdigest()[:digits]}"
+
+    count = {}
+    for f in dict.fromkeys(os.path.abspath(os.fspath(f)) for f in files):
+        count[Path(f).stem.casefold()] = count.get(Path(f).stem.casefold(), 0) + 1
+    names = {}
     for f in files:
-        stem = Path(f).stem
-        seen[stem] = seen.get(stem, 0) + 1
-        out.append(stem if seen[stem] == 1 else f"{stem}-{seen[stem]}")
-    return out
+        key = os.path.abspath(os.fspath(f))
+        if key not in names:
+            names[key] = Path(f).stem if count[Path(f).stem.casefold()] == 1 else hashed(f, 8)
+    # a plain stem may equal another file's hashed name (a file named rec-3f2a91c0.npz): longer hashes
+    taken = {}
+    for key, name in names.items():
+        taken.setdefault(name.casefold(), []).append(key)
+    for name, keys in taken.items():
+        if len(keys) > 1:
+            for key in keys:
+                names[key] = hashed(key, 16)
+    return [names[os.path.abspath(os.fspath(f))] for f in files]
 
 
 def _read(args) -> dict:
@@ -101,10 +123,18 @@ def run(args) -> int:
                      executor=executor, workers=workers, checkpoint=parts)
     except (FileError, ValueError, ImportError, OSError) as e:
         return _error(e)
+    seen = {}
+
+    def said(status):
+        seen["status"] = status
+        if status.reused:
+            print(f"resuming: {status.reused} of {status.total} files are fitted in {parts}/", flush=True)
+        if status.changed:
+            print(f"{status.changed} of {status.total} files changed since their fits: refitting them", flush=True)
+
+    batch["on_resume"] = said
     with interruptible():
         try:
-            if held:
-                print(f"resuming: {held} of {len(args.files)} files are fitted in {parts}/", flush=True)
             try:
                 result = identify_many(args.files, **batch)
             except CheckpointError:
@@ -112,12 +142,15 @@ def run(args) -> int:
                     raise
                 print(f"{parts}/ held the fits of another batch: replaced", flush=True)
                 clear(parts)
+                held = 0
                 result = identify_many(args.files, **batch)
             return _write(args, out, parts, result)
         except (FileError, ValueError, ImportError, OSError) as e:
             return _error(e)
         except Interrupted as e:
-            print(f"lptv identify: interrupted by {signal.Signals(e.signum).name}: {stored_items(parts) or 0} of "
+            # the files of this batch on disk: those read back, and every part written since
+            kept = (seen["status"].reused + (stored_items(parts) or 0) - (held or 0)) if "status" in seen else 0
+            print(f"lptv identify: interrupted by {signal.Signals(e.signum).name}: {kept} of "
                   f"{len(args.files)} files are fitted and kept in {parts}/; rerun the same command with --resume "
                   "to complete the batch", file=sys.stderr)
             return e.status
@@ -142,15 +175,17 @@ def _write(args, out, parts, result) -> int:
     try:
         (out / "models").mkdir(parents=True, exist_ok=True)
         result.save(out / "results.csv")
-        for stem, model in zip(_stems(args.files), result.models):
+        models = {}
+        for f, stem, model in zip(args.files, _stems(args.files), result.models):
             if model is not None:
                 model.save(out / "models" / f"{stem}.json")
+                models[f] = f"models/{stem}.json"
         write_json(out / "summary.json", {
             "files": len(result.rows), "fitted": len(result.rows) - result.n_failed,
             "failed": result.n_failed, "not_converged": sum(1 for r in result.rows if r["ok"] and not r["converged"]),
             "residue_outside_band": sum(1 for r in result.rows if r["ok"] and not r["residue_ok"]),
             "method": args.method, "executor": result.executor, "seconds": result.elapsed,
-            "failures": [{"file": f, "error": e} for f, e in result.failures]})
+            "failures": [{"file": f, "error": e} for f, e in result.failures], "models": models})
     except OSError as e:
         return _error(f"{e.filename or out}: {e.strerror or e}")
     print(f"{len(result.rows) - result.n_failed} of {len(result.rows)} files fitted; wrote "

@@ -308,7 +308,8 @@ def _check_executor(executor, workers):
 
 def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="processes",
               workers: Optional[int] = None, chunk_size: Optional[int] = None, progress=None,
-              desc: str = "lptv", unit: str = "item", weight: int = 1, checkpoint=None) -> List[Any]:
+              desc: str = "lptv", unit: str = "item", weight: int = 1, checkpoint=None,
+              labels: Optional[Sequence[str]] = None, on_resume: Optional[Callable] = None) -> List[Any]:
     """``[fn(item, shared) for item in items]`` on an executor, in chunks, with progress.
 
     Parameters
@@ -337,7 +338,15 @@ def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="pr
         A folder where each finished chunk is written as it completes (:mod:`lptv.batch.parts`);
         the items it already holds (of the same study) are read back instead of run again, so
         that a study interrupted (Ctrl-C, a kill, a lost cluster) resumes where it stopped with
-        the same results, bit for bit. A folder holding another study is refused (ValueError).
+        the same results, bit for bit. Each result is stored under its item's key (a hash of
+        the item by content), so that an item that changed since (a rewritten file) runs again.
+        A folder holding another study is refused (ValueError).
+    labels : sequence of str, optional
+        With ``checkpoint``: a stable name per item (e.g. its file), so that the checkpoint can
+        tell an item that changed since its result was stored from a new one.
+    on_resume : callable, optional
+        With ``checkpoint``: called once, before anything runs, with the
+        :class:`lptv.batch.parts.ResumeStatus` of the folder (items read back, changed, new).
 
     Returns
     -------
@@ -363,8 +372,12 @@ def run_tasks(fn: Callable, items: Sequence, shared: Any = None, *, executor="pr
     if checkpoint is not None:
         from .parts import Checkpoint
 
-        store = Checkpoint(checkpoint, fn, items, shared, desc)
+        if labels is not None and len(labels) != len(items):
+            raise ValueError(f"labels must give one label per item ({len(items)}), got {len(labels)}")
+        store = Checkpoint(checkpoint, fn, items, shared, desc, labels=labels)
         done = store.load()
+        if on_resume is not None:
+            on_resume(store.status)
         for i, r in done.items():
             out[i] = r
         todo = [i for i in todo if i not in done]
@@ -419,8 +432,11 @@ def _ignore_interrupts():
     to handle; the worker finishes its chunk and is shut down by the parent."""
     import signal
 
+    from .warm import watch_parent
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    watch_parent()
 
 
 def _is_lptv(fn) -> bool:
@@ -473,20 +489,26 @@ def _run_futures(fn, items, todo, shared, executor, workers, chunk_size, bar, we
 _shared_on = weakref.WeakKeyDictionary()   # Dask client -> (digest, future) of the last shared argument
 
 
+def _identity(x):
+    return x
+
+
 def _scattered(client, shared):
-    """``shared`` on every worker of ``client``'s cluster, as a future: one copy per worker
-    instead of one per task, scattered once and kept for the next call with equal contents (a
+    """``shared`` on the cluster as a future that every chunk depends on: one copy per worker
+    that runs a chunk instead of one per task, kept for the next call with equal contents (a
     study repeated with the same design skips the round trip, 5-7 ms on a 2-core LocalCluster).
-    In a list, so that it gets a key of its own (a dict would be scattered under its own keys,
-    shared by every run)."""
+    It is a task (``_identity(shared)``), not scattered data: the scheduler holds its recipe, so
+    when the workers that hold its value die, one after another, it is computed again on a live
+    one, and the chunks still to run lose nothing (scattered data has no recipe: once its last
+    holder died, every chunk waiting for it was cancelled)."""
     try:
         digest = hashlib.blake2b(pickle.dumps(shared, protocol=pickle.HIGHEST_PROTOCOL), digest_size=20).digest()
     except Exception:  # noqa: BLE001 - not picklable by pickle (Dask's cloudpickle may manage): no reuse
         digest = None
     kept = _shared_on.get(client)
-    if digest is not None and kept is not None and kept[0] == digest and kept[1].status == "finished":
+    if digest is not None and kept is not None and kept[0] == digest and kept[1].status in ("finished", "pending"):
         return kept[1]
-    [fut] = client.scatter([shared], broadcast=True, hash=False)
+    fut = client.submit(_identity, shared, pure=False, priority=1 << 30)
     if digest is not None:
         _shared_on[client] = (digest, fut)
     return fut

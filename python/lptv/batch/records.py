@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import os
 import time
 import warnings
@@ -63,10 +64,27 @@ def _w0(w0, w0_record, ts, n_samples):
     return float(w0)
 
 
+def file_digest(path) -> Optional[str]:
+    """The SHA-256 of a file's bytes (None when it cannot be read here: on a cluster whose
+    workers alone see it)."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()
+
+
 def identify_record(item, settings) -> dict:
-    """One record (the task :func:`identify_many` sends out): read, identify, return plain data."""
-    name, record = item
+    """One record (the task :func:`identify_many` sends out): read, identify, return plain data.
+    A file's item carries the digest of its bytes when the batch was planned: a file that
+    changed since is refused (its result would not be the one the checkpoint stores it as)."""
+    name, record, digest = item if len(item) == 3 else (*item, None)
     u, y, w0_record, fmt = _arrays(record, dict(settings.get("read") or {}, periods=settings["periods"]))
+    if digest is not None and file_digest(record) != digest:
+        raise ValueError("the file changed while the batch ran: run the batch again to fit its new contents")
     u, y = np.asarray(u), np.asarray(y)
     n_samples = u.shape[-1] if u.ndim else 0
     w0 = _w0(settings["w0"], w0_record, settings["ts"], n_samples)
@@ -190,7 +208,7 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
                   names: Optional[Sequence[str]] = None, covariance: str = "analytic",
                   executor="processes", workers: Optional[int] = None,
                   chunk_size: Optional[int] = None, progress: Optional[bool] = None,
-                  checkpoint=None) -> BatchResult:
+                  checkpoint=None, on_resume=None) -> BatchResult:
     """:func:`lptv.identify` on many records, one row of results per record.
 
     A record that cannot be read or fitted (a bad file, NaN in the data, a singular system)
@@ -224,8 +242,13 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
         Where and how the fits run (:func:`lptv.batch.run_tasks`).
     checkpoint : str or Path, optional
         A folder where every finished chunk of records is written as it completes; a rerun
-        with the same records, options and folder fits only the records it lacks
-        (:mod:`lptv.batch.parts`).
+        with the same options and folder fits only the records it lacks: a record read from a
+        file is known by its name and the SHA-256 of the file's bytes, so that a file rewritten
+        since its fit is fitted again, and nothing else (:mod:`lptv.batch.parts`). A file
+        that changes while the batch runs fails with that message.
+    on_resume : callable, optional
+        With ``checkpoint``: called once before any fit with the folder's
+        :class:`lptv.batch.parts.ResumeStatus` (records read back, changed since their fits, new).
 
     Returns
     -------
@@ -271,9 +294,11 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     if covariance != "analytic":   # the settings of earlier checkpoints stay as they were
         settings["fit"]["covariance"] = covariance
     t0 = time.perf_counter()
-    out = run_tasks(identify_record, [(n, _slim(r)) for n, r in zip(names, recs)], settings, executor=executor,
+    items = [(n, _slim(r), file_digest(r) if checkpoint is not None and isinstance(r, (str, os.PathLike)) else None)
+             for n, r in zip(names, recs)]
+    out = run_tasks(identify_record, items, settings, executor=executor,
                     workers=workers, chunk_size=chunk_size, progress=progress, desc="identify",
-                    unit="record", checkpoint=checkpoint)
+                    unit="record", checkpoint=checkpoint, labels=names, on_resume=on_resume)
     elapsed = time.perf_counter() - t0
 
     rows, models, eta_names = [], [], []
