@@ -2,7 +2,9 @@
 about the sampling frequency (the helpers of :func:`lptv.read_measurements`).
 
 - Channels by name: ``u=`` / ``y=`` (``--input`` / ``--output``) name a CSV column, an NPZ array
-  or a MAT variable; by default ``u`` and ``y``. A wrong name lists what the file holds.
+  or a MAT variable; by default ``u`` and ``y``. A name matches up to case and a trailing unit
+  (``force`` finds ``force [N]`` and ``Force (N)``); several matches are listed, a wrong name
+  lists what the file holds.
 - The sampling frequency from the file: a time column or variable (``time=``, by default one
   named ``t`` or ``time``, optionally with its unit: ``time [s]``, ``t_ms``), checked uniform,
   or a stored scalar ``fs`` (Hz) or ``dt`` / ``Ts`` (s).
@@ -22,6 +24,8 @@ class FileError(ValueError):
 ROLES = {"u": ("input", "u=", "--input"), "y": ("output", "y=", "--output"), "time": ("time", "time=", "--time")}
 
 _TIME = re.compile(r"^(t|time|timestamp)\s*(?:[\[(]\s*(s|sec|seconds|ms|us)\s*[\])]|[_ ](s|sec|ms|us))?$")
+# A trailing unit: 'force [N]', 'force (N)'.
+_UNIT_SUFFIX = re.compile(r"^(.*?)\s*(?:\[([^\[\]]*)\]|\(([^()]*)\))$")
 _UNIT = {"s": 1.0, "sec": 1.0, "seconds": 1.0, "ms": 1e-3, "us": 1e-6, None: 1.0}
 # Stored sampling variables (exact names): Hz, or seconds per sample.
 FS_NAMES = ("fs", "Fs", "FS")
@@ -51,18 +55,39 @@ def one_output_message(names):
             "at a time (MIMO models are not supported yet); run once per output channel")
 
 
+def split_unit(name: str) -> Tuple[str, Optional[str]]:
+    """('force', 'n') from 'Force [N]' or 'force (N)'; ('force', None) from 'force': the name
+    without a trailing unit in brackets or parentheses, and the unit, both in lower case."""
+    m = _UNIT_SUFFIX.match(name.strip())
+    if not m or not m.group(1).strip():
+        return name.strip().lower(), None
+    return m.group(1).strip().lower(), (m.group(2) or m.group(3)).strip().lower()
+
+
+def _same_channel(wanted: str, name: str) -> bool:
+    """Equal up to case and a trailing unit that only one of them states (units that are both
+    given must agree: 'force [kN]' is not 'force [N]')."""
+    (a, ua), (b, ub) = split_unit(wanted), split_unit(name)
+    return a == b and (ua is None or ub is None or ua == ub)
+
+
 def find(wanted: str, available: Sequence[str], role: str, kind: str, shown) -> str:
     """The file's name for a wanted channel: exact, else the one name equal up to case and
-    spaces; FileError listing the file's channels (``shown``, a str or a function giving one)
-    otherwise."""
+    spaces, else the one equal up to case and a trailing unit (``force`` finds ``force [N]``
+    or ``Force (N)``); FileError listing the candidates when several match, or the file's
+    channels (``shown``, a str or a function giving one) when none does."""
     if wanted in available:
         return wanted
     key = wanted.strip().lower()
     near = [a for a in available if a.strip().lower() == key]
+    if not near:
+        near = [a for a in available if _same_channel(wanted, a)]
     if len(near) == 1:
         return near[0]
     if len(near) > 1:
-        raise FileError(f"{kind} '{wanted}' is ambiguous: the file has {', '.join(repr(n) for n in near)}")
+        word, kw, opt = ROLES[role]
+        raise FileError(f"{kind} '{wanted}' is ambiguous: the file has {', '.join(repr(n) for n in near)}; "
+                        f"name one of them exactly with {opt} ({kw})")
     if role == "y" and "," in wanted:
         parts = [p.strip() for p in wanted.split(",") if p.strip()]
         if len(parts) > 1:

@@ -93,6 +93,26 @@ def test_the_default_channel_names_and_a_wrong_name_list_what_the_file_has(recor
     assert lptv.read_measurements(src, u="FORCE", y="Displacement", period=T0).input == "force"
 
 
+def test_names_match_a_header_with_a_unit_and_an_ambiguous_name_lists_the_candidates(record, tmp_path, capsys):
+    u, y = record
+    src = rig_csv(tmp_path / "units.csv", u, y, header="time [s],Force (N),displacement [m]")
+    m = lptv.read_measurements(src, u="force", y="DISPLACEMENT", period=T0)
+    assert (m.input, m.output, m.fs) == ("Force (N)", "displacement [m]", FS)
+    np.testing.assert_array_equal(m.u, u)
+    assert lptv.read_measurements(src, u="force (N)", y="displacement", period=T0).input == "Force (N)"
+    # a unit given on both sides must agree
+    with pytest.raises(FileError, match=r"column 'force \[kN\]', the input named by --input \(u=\), is missing"):
+        lptv.read_measurements(src, u="force [kN]", y="displacement", period=T0)
+    both = rig_csv(tmp_path / "two.csv", u, y, header="time,force [N],force (kN)")
+    with pytest.raises(FileError, match=r"column 'force' is ambiguous: the file has 'force \[N\]', "
+                                        r"'force \(kN\)'; name one of them exactly with --input"):
+        lptv.read_measurements(both, u="force", y="force [N]", period=T0)
+    rc, out, err = identify_cli(capsys, src, "--input", "force", "--output", "displacement", "--period", T0,
+                                *FIT, "--out", tmp_path / "o")
+    assert rc == 0, err
+    assert "input 'Force (N)', output 'displacement [m]'" in out.splitlines()[0]
+
+
 def test_several_outputs_are_refused_one_at_a_time(record, tmp_path, capsys):
     src = rig_csv(tmp_path / "rig.csv", *record)
     rc, out, err = identify_cli(capsys, src, "--input", "force", "--output", "displacement,time",
