@@ -56,6 +56,7 @@ class Measurements:
     u: np.ndarray
     y: np.ndarray
     w0: Optional[float]
+    """The fundamental (rad/s): the file's ``w0``, else ``2 pi / period`` when ``period`` was given."""
     format: str
     fs: Optional[float] = None
     """The sampling frequency (Hz) when it was given or read from the file; None otherwise."""
@@ -214,6 +215,8 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
             raise FileError(f"--skip-periods {skip_periods} leaves {P - skip_periods} of "
                             f"{P} periods; the noise model needs at least 2")
         u_p, y_p = u_p[..., skip_periods:, :], y_p[..., skip_periods:, :]
+    if w0 is None and split.period is not None:
+        w0 = 2 * np.pi / split.period      # the period given
     return Measurements(u=u_p, y=y_p, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods,
                         input=raw.names[0], output=raw.names[1], fs_source=source)
 

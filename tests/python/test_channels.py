@@ -98,6 +98,7 @@ def test_names_match_a_header_with_a_unit_and_an_ambiguous_name_lists_the_candid
     src = rig_csv(tmp_path / "units.csv", u, y, header="time [s],Force (N),displacement [m]")
     m = lptv.read_measurements(src, u="force", y="DISPLACEMENT", period=T0)
     assert (m.input, m.output, m.fs) == ("Force (N)", "displacement [m]", FS)
+    assert m.w0 == 2 * np.pi / T0                       # the period given, as the fundamental
     np.testing.assert_array_equal(m.u, u)
     assert lptv.read_measurements(src, u="force (N)", y="displacement", period=T0).input == "Force (N)"
     # a unit given on both sides must agree

@@ -114,7 +114,8 @@ def fundamental(args, meas):
     if meas.w0 is not None:
         if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
             raise FileError(f"{given} gives w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
-        w0, given = meas.w0, "the file's w0"
+        if w0 is None:
+            w0, given = meas.w0, "the file's w0"
     if meas.fs is not None and w0 is None:
         w0 = 2 * np.pi * meas.fs / meas.u.shape[-1]
     if positive(args.ts, "--ts") is not None:
