@@ -174,14 +174,24 @@ def test_atomic_open_leaves_the_old_file_when_the_writer_fails(tmp_path):
 
 # ------------------------------------------------------------------------------ a cluster's faults
 
-def test_a_dask_worker_killed_mid_study_costs_only_its_chunk(tmp_path):
-    """A LocalCluster worker killed by its pid while the study runs: its chunk runs again on
-    another worker, and the study is complete and identical to the serial one."""
+def _holders_of_dependencies(dask_scheduler):
+    """The workers that hold the data the tasks still to run depend on (the study's design)."""
+    keys = {d.key for ts in dask_scheduler.tasks.values()
+            if ts.state in ("processing", "queued", "waiting", "no-worker") for d in ts.dependencies}
+    return sorted({ws.address for k in keys if k in dask_scheduler.tasks for ws in dask_scheduler.tasks[k].who_has})
+
+
+def test_dask_workers_killed_one_after_the_other_mid_study_lose_nothing(tmp_path):
+    """Both LocalCluster workers killed by their pids, one after the other, mid-study: first one
+    of them, then the other as soon as the scheduler knows it is the only holder of the study's
+    design (the data every chunk still to run depends on), while the first one's successor is
+    starting. The chunks they held run again on the successors, the design is not lost with its
+    last holder, and the study is complete and identical to the serial one."""
     distributed = pytest.importorskip("distributed")
     import threading
 
     ms = lptv.multisine(range(1, 21), 128, amplitudes=np.sqrt(2 / 20), seed=1)
-    kw = dict(periods=4, runs=600, methods="sml", snr_in_db=50, snr_out_db=30, seed=3, progress=False)
+    kw = dict(periods=4, runs=1200, methods="sml", snr_in_db=50, snr_out_db=30, seed=3, progress=False)
     parts = tmp_path / "parts"
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
                                   host="127.0.0.1") as cluster, distributed.Client(cluster) as client:
@@ -193,15 +203,66 @@ def test_a_dask_worker_killed_mid_study_costs_only_its_chunk(tmp_path):
         while (stored_items(parts) or 0) < 40 and run.is_alive() and time.monotonic() < deadline:
             time.sleep(0.02)
         pids = client.run(os.getpid)
-        done_at_kill = stored_items(parts)
-        os.kill(sorted(pids.values())[0], signal.SIGKILL)
+        first = min(pids.values())
+        done_at_kills = [stored_items(parts)]
+        os.kill(first, signal.SIGKILL)
+        holders = []
+        while run.is_alive() and time.monotonic() < deadline:
+            holders = client.run_on_scheduler(_holders_of_dependencies)
+            if len(holders) == 1 and holders[0] in pids and pids[holders[0]] != first:
+                break
+            time.sleep(0.01)
+        done_at_kills.append(stored_items(parts))
+        os.kill(pids[holders[0]], signal.SIGKILL)
         run.join(timeout=300)
-    assert done_at_kill < kw["runs"], "the study ended before the worker was killed: make it longer"
+    assert done_at_kills[-1] < kw["runs"], f"the study ended before the last kill ({done_at_kills}): make it longer"
     mc = box["mc"]
-    assert all(f["ok"] for f in mc.fits)
+    assert all(f["ok"] for f in mc.fits), [f["error"] for f in mc.fits if not f["ok"]][:1]
     ref = lptv.montecarlo(MODEL, ms, executor="serial", **kw)
     pd.testing.assert_frame_equal(mc.table(), ref.table())
     pd.testing.assert_frame_equal(mc.fit_table(), ref.fit_table())
+
+
+def test_pool_workers_end_when_the_command_is_killed(tmp_path):
+    """lptv montecarlo killed by SIGKILL mid-study: its pool's workers are gone 5 s later."""
+    MODEL.save(tmp_path / "model.json")
+    out = tmp_path / "mc"
+    p = subprocess.Popen(LPTV + study_args(out), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while parts_in(out) < 2 and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert p.poll() is None, "the study ended before it could be killed: make it longer"
+    children = _children(p.pid)
+    assert len(children) >= 2, children              # the two workers (and the pool's helpers)
+    p.kill()
+    p.wait()
+    time.sleep(5)
+    alive = [c for c in children if _alive(c)]
+    for c in alive:
+        os.kill(c, signal.SIGKILL)
+    assert not alive, f"{len(alive)} of {len(children)} workers outlived their parent"
+
+
+def _children(pid):
+    kids = []
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                with open(f"/proc/{d}/stat") as f:
+                    fields = f.read().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                kids.append(int(d))
+    return kids
+
+
+def _alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
 
 
 CLUSTER = """
