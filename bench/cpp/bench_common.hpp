@@ -2,8 +2,12 @@
 #pragma once
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <random>
 #include <vector>
 
@@ -91,5 +95,33 @@ inline double rel_error(const Eigen::VectorXcd& Y, const Eigen::VectorXcd& Yref,
 }
 
 inline double db(double x) { return 20.0 * std::log10(std::max(x, 1e-300)); }
+
+// Argument i of the command line as an integer in [lo, hi], `def` where it is absent; anything
+// else ends the program with a one-line message and exit status 2.
+inline long int_arg(int argc, char** argv, int i, long def, long lo, long hi, const char* name, const char* usage) {
+  if (i >= argc) return def;
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(argv[i], &end, 10);
+  if (end == argv[i] || *end || errno || v < lo || v > hi) {
+    std::fprintf(stderr, "%s: argument %d must be an integer from %ld to %ld, got '%s' (usage: %s)\n", name, i, lo,
+                 hi, argv[i], usage);
+    std::exit(2);
+  }
+  return v;
+}
+
+// Runs a benchmark's body; an exception ends it with one line naming the benchmark and the cause
+// (exit status 1), instead of std::terminate's report.
+template <class F>
+int guarded_main(const char* name, F&& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    return 1;
+  }
+}
 
 }  // namespace bench

@@ -27,6 +27,7 @@
 //
 // Usage: bench_fds_floor [lines ...]   (default 100001; lines = 2L + 1)
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -105,9 +106,19 @@ __attribute__((always_inline)) inline double floor_solve_impl(const FloorData& d
   kcd zw[K + 1][NZ];
   kcd phase = std::polar(1.0, lptv::detail::kCheckPhaseStep * (L + 1));
   // A row (line l) into window position pos, with its right-hand sides; t and uw hold the
-  // lines l + K .. l - K. Top rows: columns beyond L are zero.
+  // lines l + K .. l - K. A row below the top enters against the lines l + K .. l - K (its
+  // diagonal at column K); the top rows (l = L - pos, pos < K) enter as the kernel's do,
+  // against the lines L .. L - 2K (the diagonal at column pos, zero beyond column K + pos: the
+  // lines above L are not in the system).
   auto enter = [&](int l, int pos, bool top) {
-    for (int j = 0; j < W; ++j) win[pos][j] = top && l + K - j > L ? kcd(0.0, 0.0) : entry(d.aj[j], t[j], NA);
+    if (top) {
+      for (int j = 0; j < W; ++j) {
+        const int c = j - pos + K;  // the same entry in the row's own frame (line l + K - c = L - j)
+        win[pos][j] = c < W ? entry(d.aj[c], t[c], NA) : kcd(0.0, 0.0);
+      }
+    } else {
+      for (int j = 0; j < W; ++j) win[pos][j] = entry(d.aj[j], t[j], NA);
+    }
     double re = 0.0, im = 0.0;
     for (int j = W - 1; j >= 0; --j) {  // lines l - K .. l + K, as the route sums them
       const kcd v = entry(d.bj[j], t[j], NB);
@@ -234,12 +245,24 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::vector<long> sizes;
-  for (int i = 1; i < argc; ++i) sizes.push_back(std::strtol(argv[i], nullptr, 10));
+  for (int i = 1; i < argc; ++i) {
+    char* end = nullptr;
+    const long n = std::strtol(argv[i], &end, 10);
+    if (end == argv[i] || *end || n < 4 * K + 3 || n > 200000001) {
+      std::fprintf(stderr, "bench_fds_floor: lines must be integers from %d to 200000001, got '%s'\n", 4 * K + 3, argv[i]);
+      return 2;
+    }
+    sizes.push_back(n);
+  }
   if (sizes.empty()) sizes.push_back(100001);
   const lptv::Model model = bench::paper_model();
-  if (model.ka() != K || model.kb() != K || model.na() != NA || model.nb() != NB) return 1;
+  if (model.ka() != K || model.kb() != K || model.na() != NA || model.nb() != NB) {
+    std::fprintf(stderr, "bench_fds_floor: the floor is compiled for K = %d, na = %d, nb = %d; bench::paper_model() "
+                 "has Ka = %d, Kb = %d, na = %d, nb = %d\n", K, NA, NB, model.ka(), model.kb(), model.na(), model.nb());
+    return 1;
+  }
   const bool avx2 = lptv::detail::avx2_kernels();
   constexpr Count c = floor_count();
   std::printf("lptv::simulate against the arithmetic floor of its band elimination; paper-like example "
@@ -274,36 +297,65 @@ int main(int argc, char** argv) {
     Eigen::MatrixXcd Ys = lptv::simulate(model, U, so).Y;
     std::vector<kcd> corner(2 * K);
     for (int i = 0; i < 2 * K; ++i) corner[i] = Ys(i, 0);
-    double t_sim = 1e300, t_vec = 1e300, t_sca = 1e300, sink = 0;
+    double t_sim = 1e300, t_vec = 1e300, t_sca = 1e300;
     const int rounds = std::max(5, std::min(200, static_cast<int>(2e7 / double(n))));
-    double diff_vec = 0, diff_sca = 0, scale = Ys.cwiseAbs().maxCoeff();
+    // max |y_floor - y_simulate| over lines 2K..L; a NaN anywhere makes it NaN (std::max would drop it).
+    auto max_diff = [&] {
+      double m = 0;
+      for (int l = 2 * K; l <= L; ++l) {
+        const double e = std::abs(y[l] - Ys(l, 0));
+        if (std::isnan(e) || e > m) m = e;
+        if (std::isnan(m)) break;
+      }
+      return m;
+    };
+    // Each floor returns the check's max |x|^2 over lines 2K..L: finite and positive whenever its
+    // work was done on finite numbers, and the same in every round (the same operations on the
+    // same data), which the rounds below verify.
+    double diff_vec = 0, diff_sca = 0, check_vec = 0, check_sca = 0;
+    const double scale = Ys.cwiseAbs().maxCoeff();
+    int check_changed = 0;
     for (int r = 0; r < rounds; ++r) {
       auto t0 = std::chrono::steady_clock::now();
       Ys = lptv::simulate(model, U, so).Y;
       t_sim = std::min(t_sim, seconds_since(t0));
       t0 = std::chrono::steady_clock::now();
-      sink += floor_avx2(d, u.data(), corner.data(), Uf.data(), z.data(), y.data());
+      const double cv = floor_avx2(d, u.data(), corner.data(), Uf.data(), z.data(), y.data());
       t_vec = std::min(t_vec, seconds_since(t0));
-      if (r == 0)
-        for (int l = 2 * K; l <= L; ++l) diff_vec = std::max(diff_vec, std::abs(y[l] - Ys(l, 0)));
+      if (r == 0) diff_vec = max_diff(), check_vec = cv;
       t0 = std::chrono::steady_clock::now();
-      sink += floor_scalar(d, u.data(), corner.data(), Uf.data(), z.data(), y.data());
+      const double cs = floor_scalar(d, u.data(), corner.data(), Uf.data(), z.data(), y.data());
       t_sca = std::min(t_sca, seconds_since(t0));
-      if (r == 0)
-        for (int l = 2 * K; l <= L; ++l) diff_sca = std::max(diff_sca, std::abs(y[l] - Ys(l, 0)));
+      if (r == 0) diff_sca = max_diff(), check_sca = cs;
+      check_changed += cv != check_vec || cs != check_sca;
     }
     const double nn = 2.0 * L + 1;
+    const double diff = std::isnan(diff_vec) || diff_vec > diff_sca ? diff_vec : diff_sca;
     std::printf("%9ld %7d %10.2f %10.2f %10.2f %9.2f %9.2f %10.1e %10.2f\n", long(nn), rounds, 1e9 * t_sim / nn,
-                1e9 * t_vec / nn, 1e9 * t_sca / nn, t_sim / t_vec, t_sim / t_sca, std::max(diff_vec, diff_sca) / scale,
-                t_sca / t_vec);
-    if (!(sink > 0)) failed = true;
-    if (!(std::max(diff_vec, diff_sca) <= 1e-12 * scale)) {
-      std::fprintf(stderr, "the floor's solution differs from simulate's at n = %ld: %.1e\n", long(nn),
-                   std::max(diff_vec, diff_sca) / scale);
+                1e9 * t_vec / nn, 1e9 * t_sca / nn, t_sim / t_vec, t_sim / t_sca, diff / scale, t_sca / t_vec);
+    if (!(std::isfinite(scale) && scale > 0)) {
+      std::fprintf(stderr, "bench_fds_floor: simulate's output is %g at its largest at n = %ld (finite and nonzero "
+                   "expected)\n", scale, long(nn));
+      failed = true;
+    }
+    if (!(diff <= 1e-12 * scale)) {
+      std::fprintf(stderr, "bench_fds_floor: the floor's solution differs from simulate's at n = %ld: %.1e relative "
+                   "(vector floor %.1e, scalar floor %.1e; NaN: a floor computed NaNs)\n", long(nn), diff / scale,
+                   diff_vec / scale, diff_sca / scale);
+      failed = true;
+    }
+    if (!(std::isfinite(check_vec) && check_vec > 0 && check_vec == check_sca) || check_changed) {
+      std::fprintf(stderr, "bench_fds_floor: the floors' conditioning check at n = %ld: max |x|^2 %g (vector), %g "
+                   "(scalar), changed in %d of %d rounds (finite, positive, equal and unchanged expected)\n",
+                   long(nn), check_vec, check_sca, check_changed, rounds);
       failed = true;
     }
   }
   std::printf("\nvs sim: max |y_floor - y_simulate| / max |y| over lines 2K..L (0: the floor's operations are the "
               "route's, bit for bit)\n");
   return failed ? 1 : 0;
+}
+
+int main(int argc, char** argv) {
+  return bench::guarded_main("bench_fds_floor", [&] { return run(argc, argv); });
 }
