@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -104,17 +105,18 @@ struct FloorStep {
     A = J;
     int lw = 0, info = 0, one = 1, nb = std::min(kBlock, std::min(m, n));
     dgeqrt_(&m, &n, &nb, A.data(), &m, tq.data(), &nb, wq.data(), &info);
+    if (info != 0) throw std::runtime_error("the floor's dgeqrt failed, info " + std::to_string(info));
     tri = A.topRows(n).triangularView<Eigen::Upper>();
     double u = 0;
     lw = int(ws.size());
     dgesvd_("N", "A", &n, &n, tri.data(), &n, s.data(), &u, &one, vt.data(), &n, ws.data(), &lw, &info);
-    if (info != 0) std::abort();
+    if (info != 0) throw std::runtime_error("the floor's dgesvd failed, info " + std::to_string(info));
   }
 };
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   const lptv::detail::SingleThreadedBlas one_thread(true);
   const lptv::Parametrisation p = paper_parametrisation();
   std::vector<int> rows;
@@ -170,7 +172,8 @@ int main(int argc, char** argv) {
     std::printf("%s: %d fits\n", argv[2], n);
     return 0;
   }
-  const int n_seeds = argc > 1 ? std::atoi(argv[1]) : 3;
+  const int n_seeds = static_cast<int>(bench::int_arg(argc, argv, 1, 3, 1, 1000, "bench_estimate_floor",
+                                                      "bench_estimate_floor [seeds] | --loop WHAT SECONDS"));
   std::printf("WGTLS and SML of the core against their LAPACK floor (paper-like example, P = %d, "
               "rows 1..243, na=2 nb=1 K=3: %d x %d real Jacobian)\n",
               kPeriods, 2 * int(rows.size()), p.n_xi());
@@ -209,4 +212,8 @@ int main(int argc, char** argv) {
   std::printf("\nWGTLS / floor (goal <= 1.5x): worst %.2fx; SML / floor (goal <= 2x): worst %.2fx\n", worst_w,
               worst_s);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return bench::guarded_main("bench_estimate_floor", [&] { return run(argc, argv); });
 }
