@@ -19,6 +19,10 @@ PIP_PINS). The checks:
   build takes from the system outside the policy. The development build's module then fails
   to load (the hiding works); the installed wheel runs, and /proc/self/maps shows the bundled
   copies loaded and none of the hidden files.
+
+What the unprivileged user reads of this checkout (README.md, the development build's module) is
+copied into its own folder first: a checkout may sit where only its owner can read (a root
+user's clone under /root, mode 700).
 """
 import json
 import os
@@ -132,6 +136,15 @@ def work(home, request):
     return _own(path)
 
 
+def _readable_copy(src, folder):
+    """A copy of src in folder that the unprivileged user can read: the checkout itself may not
+    be readable to it (a clone under /root, mode 700)."""
+    dst = Path(folder) / Path(src).name
+    shutil.copyfile(src, dst)
+    dst.chmod(0o644)
+    return dst
+
+
 def _as_user(argv, home, cwd=None, **kw):
     """argv as the unprivileged user, with a plain environment (no venv, no library path)."""
     drop = ("LD_LIBRARY_PATH", "LD_PRELOAD", "PYTHONPATH", "VIRTUAL_ENV", "PIP_CACHE_DIR")
@@ -237,6 +250,7 @@ def _run_hidden(argv, hidden, home, cwd, **kw):
         pytest.skip(f"unshare --mount --map-root-user is not allowed here: {probe.stderr[-300:]}")
     empty = home / "empty"
     empty.write_bytes(b"")
+    empty.chmod(0o644)
     script = ('e=$1; shift; while [ "$1" != -- ]; do mount --bind "$e" "$1" || exit 97; shift; done; '
               'shift; exec "$@"')
     return _as_user(["unshare", "--mount", "--map-root-user", "sh", "-c", script, "sh", empty, *hidden,
@@ -248,7 +262,8 @@ def test_the_development_build_needs_the_hidden_libraries(hidden, home, work):
     and with them hidden it cannot."""
     import lptv._core
 
-    load = [_interpreter(), "-c", "import ctypes, sys; ctypes.CDLL(sys.argv[1])", lptv._core.__file__]
+    module = _readable_copy(lptv._core.__file__, work)   # the same file, where the user can read it
+    load = [_interpreter(), "-c", "import ctypes, sys; ctypes.CDLL(sys.argv[1])", module]
     _ok(_as_user(load, home, cwd=work))
     r = _run_hidden(load, hidden, home, work)
     assert r.returncode not in (0, 97), r.stderr
@@ -276,7 +291,9 @@ def test_readme_example_runs_from_the_wheel_with_the_debian_libraries_hidden(bar
     venv = bare
     script = work / "readme_example.py"
     script.write_text(README_RUN)
-    r = _run_hidden([venv / "bin" / "python", script, ROOT / "README.md"], hidden, home, work, timeout=600)
+    script.chmod(0o644)
+    readme = _readable_copy(ROOT / "README.md", work)
+    r = _run_hidden([venv / "bin" / "python", script, readme], hidden, home, work, timeout=600)
     assert r.returncode == 0, r.stderr[-3000:]
     out = json.loads(r.stdout.strip().splitlines()[-1])
     assert out["converged"] and out["residue_ok"]
