@@ -9,6 +9,7 @@ ValueError is used for wrong types too, consistently, as the layer always has.
 from __future__ import annotations
 
 import json
+import sys
 import os
 from typing import Optional
 
@@ -182,11 +183,27 @@ def load_json(path, name="path"):
     with open(p, "rb") as f:
         raw = f.read()
     try:
-        return json.loads(raw.decode("utf-8-sig"))
+        return json.loads(raw.decode("utf-8-sig"), parse_int=_json_int)
     except UnicodeDecodeError:
         raise ValueError(f"{p}: not a JSON file (binary data that is not UTF-8 text)") from None
     except json.JSONDecodeError as e:
         raise ValueError(f"{p}: not valid JSON ({e})") from None
+    except RecursionError:
+        raise ValueError(f"{p}: JSON nested deeper than any lptv file ({sys.getrecursionlimit()} levels or "
+                         "more): not a file lptv wrote") from None
+    except ValueError as e:      # _json_int's, and Python's limit on the digits of an integer
+        raise ValueError(f"{p}: {e}") from None
+
+
+JSON_INT_DIGITS = 40
+"""The most digits an integer of a JSON file lptv reads may have (a count, a version, a 128-bit seed)."""
+
+
+def _json_int(text):
+    digits = len(text.lstrip("-"))
+    if digits > JSON_INT_DIGITS:
+        raise ValueError(f"an integer of {digits} digits (at most {JSON_INT_DIGITS}): not a value lptv wrote")
+    return int(text)
 
 
 def as_seed(seed, name="seed"):

@@ -537,6 +537,21 @@ def _rows(lines):
     return as_lines(lines, "lines")
 
 
+def _below_nyquist(lines, max_line):
+    """Lines above the data's highest line (N/2, the Nyquist line) named as such, before a long
+    list of them is converted (``lines=range(1, 10**8)`` on 2048 samples per period)."""
+    if lines is None or isinstance(lines, str):
+        return
+    try:
+        top = np.max(np.asarray(lines)) if np.size(lines) else None
+    except (TypeError, ValueError):
+        return                       # not numbers: as_lines names the problem
+    if top is not None and np.isreal(top) and np.isfinite(top) and top > max_line:
+        raise ValueError(f"lines: line {top:.0f} lies above the Nyquist line {max_line} of the data "
+                         f"({2 * max_line} or {2 * max_line + 1} samples per period: line N/2 is half the "
+                         "sampling frequency, the highest a period holds)")
+
+
 _DEFAULT_LINES = "excited"  # what lines=None means: the usable lines K+1..Lmax-K
 
 
@@ -746,6 +761,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
             if lines != "excited":
                 raise ValueError(f"lines must be a sequence of integers or 'excited', got {lines!r}")
             lines = excited_rows(data, max(ka_l + kb_l))
+        _below_nyquist(lines, data.max_line)
         rows = [] if lines is None else _rows(lines)
         r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter),
                            rows=rows, covariance=analytic)

@@ -328,11 +328,9 @@ def _shape(a):
 
 
 def _read_csv(path, names):
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise FileError("not a text file (is it really CSV?)") from None
-    rows = csv.reader(io.StringIO(text), delimiter=_delimiter(text))
+    text = _csv_text(path)
+    delimiter = _delimiter(text)
+    rows = _Rows(text, delimiter)
     header = next((r for r in rows if any(c.strip() for c in r)), None)
     if header is None:
         raise FileError("the file is empty")
@@ -353,17 +351,17 @@ def _read_csv(path, names):
         cols["time"] = heads.index(t_name)
     values = {k: [] for k in cols}
     line_of = []
-    need = max(cols.values()) + 1
     t_ok = True
     for row in rows:
         if not any(c.strip() for c in row):
             continue
-        if len(row) < need:
-            raise FileError(f"line {rows.line_num}: {len(row)} field(s), the header has {len(header)}")
+        if len(row) != len(header):
+            raise FileError(f"line {rows.line_num}: {len(row)} field(s), the header has {len(header)}"
+                            + _field_hint(row, header, delimiter))
         for role, i in cols.items():
             cell = row[i].strip()
             try:
-                values[role].append(float(cell))
+                values[role].append(_number(cell, delimiter))
             except ValueError:
                 if role == "time" and not names["time"]:
                     t_ok = False     # a column named like a time that holds no numbers: not used
@@ -385,6 +383,55 @@ def _read_csv(path, names):
         return fs_from_time(values["time"], f"column '{t_name}'", scale, line_of), f"column '{t_name}'"
 
     return _Raw(np.array(values["u"]), np.array(values["y"]), None, found, "column", chosen, line_of)
+
+
+def _csv_text(path):
+    """A CSV file's text: UTF-8 (with or without a byte-order mark) or UTF-16 with its mark;
+    UTF-16 without a mark, or bytes that are no text, named as such."""
+    data = path.read_bytes()
+    head = data[:4096]
+    if head[:2] not in (b"\xff\xfe", b"\xfe\xff") and b"\x00" in head:
+        # NUL bytes, which no UTF-8 text holds (though they decode): UTF-16 has one in every
+        # other byte of ASCII text
+        if head[1::2].count(0) > 0.4 * len(head[1::2]) or head[0::2].count(0) > 0.4 * len(head[0::2]):
+            raise FileError("looks like UTF-16 text without a byte-order mark: save it as UTF-8 "
+                            "(or UTF-16 with its byte-order mark)")
+        raise FileError("not a text file (it holds NUL bytes; is it really CSV?)")
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        try:
+            text = data.decode("utf-16")
+        except UnicodeDecodeError:
+            text = None
+        if text is None or not text[1:].replace("\n", "").replace("\r", "").replace("\t", "").isprintable():
+            raise FileError("not a text file (it starts with a UTF-16 byte-order mark, but what follows is "
+                            "not UTF-16 text; is it really CSV?)")
+        return text.lstrip("\ufeff")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise FileError("not a text file in UTF-8 or UTF-16 (is it really CSV?)") from None
+
+
+class _Rows:
+    """csv.reader over the text, its errors (a field over the csv module's limit, a NUL byte)
+    as a FileError naming the line."""
+
+    def __init__(self, text, delimiter):
+        self._rows = csv.reader(io.StringIO(text), delimiter=delimiter)
+
+    @property
+    def line_num(self):
+        return self._rows.line_num
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        try:
+            return next(self._rows)
+        except csv.Error as e:
+            hint = (": a quote that is never closed, or not a CSV file" if "field larger" in str(e) else "")
+            raise FileError(f"line {self._rows.line_num}: {_one_line(e)}{hint}") from None
 
 
 def _csv_periods(raw, split):
@@ -414,6 +461,31 @@ def _not_transposed(what, a, samples, split):
                "samples; --periods is the number of periods")
     if looks_transposed(a, other):
         raise FileError(f"{what} read as {P} periods of {N} samples does not repeat from period to period; {how}")
+
+
+def _number(cell, delimiter):
+    """A cell's value; with ';' or tabs between the columns a decimal comma is read too
+    ('1,5' is 1.5, as the locales that write it separate their columns so)."""
+    try:
+        return float(cell)
+    except ValueError:
+        if delimiter != "," and cell.count(",") == 1 and "." not in cell:
+            return float(cell.replace(",", "."))
+        raise
+
+
+def _field_hint(row, header, delimiter):
+    """Why a row's field count may differ from the header's: decimal commas in a comma-separated
+    file, another delimiter than the header's, or a missing or extra value."""
+    if delimiter == "," and len(row) > len(header):
+        return (" (decimal commas? '1,5' in a comma-separated file reads as two fields: export with a "
+                "decimal point, or separate the columns with ';' or a tab)")
+    if len(row) == 1 and len(header) > 1 and any(c in row[0] for c in ",;\t" if c != delimiter):
+        return f" (the header is separated by {_DELIMITERS[delimiter]}, this row by another delimiter)"
+    return " (a value missing or one too many: every row must have one value per column)"
+
+
+_DELIMITERS = {",": "commas", ";": "semicolons", "\t": "tabs"}
 
 
 def _delimiter(text):

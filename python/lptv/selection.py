@@ -163,6 +163,11 @@ def _key(criterion):
                       r["n_free_parameters"], r["na"], r["nb"], r["k"])
 
 
+MAX_GRID = 2000
+"""The most structures :func:`select` fits in one call: at a few ms to a few hundred ms per fit
+(more for high orders), larger grids run for hours; a grid above it is refused before any fit."""
+
+
 def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optional[float] = None,
            lines=None, criterion: str = "mdl", refine: int = 2, alpha: float = 1e-3, tol: float = 1e-10,
            max_iter: int = 50, executor="processes", workers: Optional[int] = None,
@@ -199,6 +204,7 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
         Steady-state periods (or a :class:`lptv.FrequencyData` as ``u``).
     na, nb, k : int or sequence of int
         The orders and harmonic counts to try (e.g. ``range(1, 4)``). ``k=None``: from the HTF.
+        At most :data:`MAX_GRID` (2000) structures in all.
     w0, ts : float
         Fundamental (rad/s); sample period for discrete time.
     lines : sequence of int, optional
@@ -253,6 +259,11 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
         notes.append(f"every HTF branch up to |k| = {k_htf} (the most this excitation can separate) stands "
                      "above the noise: the data do not bound the harmonic count from above (a time-varying "
                      "denominator has branches beyond k)")
+    size = len(na_list) * len(nb_list) * len(k_list)
+    if size > MAX_GRID:
+        raise ValueError(f"na, nb, k: the grid holds {size} structures ({len(na_list)} na x {len(nb_list)} nb x "
+                         f"{len(k_list)} k), more than lptv.selection.MAX_GRID = {MAX_GRID}: narrow the ranges "
+                         "(the HTF estimate and a first coarse grid tell where to look)")
     k_max = max(k_list)
     if lines is None:
         rows = list(range(k_max + 1, data.max_line - k_max + 1))

@@ -290,7 +290,7 @@ OPTION_ERRORS = [
     (["--w0", "-1"], "--w0 must be a positive number, got -1"),
     (["--w0", "1.5"], "--w0 and --ts 0.1 give 41.8879 samples per period, but the record has 64"),
     # from the library, passed on with the file name
-    (["--lines", "1-40"], "lines: row 33 needs lines up to 33"),
+    (["--lines", "1-40"], "lines: line 40 lies above the Nyquist line 32 of the data"),
     (["--known", "c1=1"], "known: 'c1' is not a coefficient name"),
     (["--ka", "1,1,1"], "ka must give one harmonic count per coefficient (2), got 3"),
 ]
@@ -374,8 +374,7 @@ def test_console_script_entry_point():
 
 
 @pytest.mark.parametrize("lines, text", [
-    ("2-40,2147483647", "lines: row 2147483647 needs lines up to 2147483648 (K = 1 harmonics) "
-                        "but the data has lines 0..128"),
+    ("2-40,2147483647", "lines: line 2147483647 lies above the Nyquist line 128 of the data"),
     ("2-40,9223372036854775808", "--lines: '9223372036854775808' goes beyond 2147483647, the largest "
                                  "value the core takes"),
 ])

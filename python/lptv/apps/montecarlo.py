@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv import METHODS, Model, montecarlo, multisine
+from lptv import METHODS, Model, NumericalError, montecarlo, multisine
 from lptv.apps.fileid import parse_lines
 from lptv.apps.options import Interrupted, in_option_terms, integer, interruptible, output_folder
 from lptv.apps.manyid import executor_of
@@ -191,6 +191,9 @@ def _study(args, model, ms, lines, what, executor, workers, parts, held) -> int:
         overview = mc.overview()
     except (FileError, ValueError, ImportError) as e:
         return _error(e)
+    except NumericalError as e:     # the design itself (its Cramer-Rao bound), before any fit
+        print(f"lptv montecarlo: error: {' '.join(str(e).split())}", file=sys.stderr)
+        return 1
     except OSError as e:   # a file that cannot be written, or a scheduler that cannot be reached
         return _error(f"{e.filename}: {e.strerror or e}" if e.filename else e)
     print(mc.report())
@@ -209,6 +212,11 @@ def _study(args, model, ms, lines, what, executor, workers, parts, held) -> int:
     except ImportError:
         wrote = "(no report.html: it needs matplotlib, pip install 'lptv[plots]') "
     print(f"wrote {out}/: {wrote}" + ", ".join(p.name for p in paths.values()) + ", summary.json")
+    failed = [f for f in mc.fits if not f["ok"]]
+    if failed:
+        print(f"lptv montecarlo: error: {len(failed)} of {len(mc.fits)} fits failed (run {failed[0]['run']}, "
+              f"{failed[0]['method']}: {failed[0]['error']}); each is a row of {out / 'fits.csv'}", file=sys.stderr)
+        return 1
     return 0
 
 

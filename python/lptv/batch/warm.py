@@ -33,6 +33,7 @@ import concurrent.futures as cf
 import contextlib
 import os
 import threading
+import time
 
 # mallopt's parameters (malloc.h); glibc's largest dynamic mmap threshold on 64 bits
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
@@ -62,8 +63,27 @@ def warm_up():
     one_blas_thread()
 
 
+def watch_parent(interval: float = 0.5):
+    """In a pool's worker: end this process when its parent dies, however it dies. A worker
+    waits on the pool's queue, whose pipe the other workers hold open too, so a parent killed
+    by SIGKILL (or the OOM killer) would leave its workers waiting forever; a daemon thread
+    compares the parent's pid every ``interval`` seconds (the worker is re-parented when its
+    parent dies) and ends the process without cleanup (the queue's locks may be held)."""
+    parent = os.getppid()
+
+    def watch():
+        while True:
+            time.sleep(interval)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="lptv-parent-watch", daemon=True).start()
+
+
 def _pool_worker_start():
     import signal
+
+    watch_parent()
 
     # Ctrl-C reaches the whole process group: it is the caller's to handle (the worker finishes
     # its chunk). SIGTERM keeps its default: when a worker dies, the pool terminates the others
