@@ -11,6 +11,8 @@ The public API:
   SML on the exact likelihood) with the covariance of the estimate;
 - :func:`crb` - the Cramer-Rao bound of a design, to plan an experiment;
 - :func:`identify_record` - one non-periodic record with its transient;
+- :func:`inspect` - a record before any model: its period, transient, excited lines and what the
+  output holds between them;
 - :func:`htf_estimate` - the harmonic transfer function's branches from data, without a model;
 - :func:`select` - the orders and harmonic count from the data (a ranked grid of structures);
 - :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
@@ -31,6 +33,7 @@ from .record import RecordResult, identify_record
 from .floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
 from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
+from .inspection import Inspection, LineClass, inspect
 from .model import Model
 from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
@@ -51,5 +54,5 @@ __all__ = [
     "lti_table", "parameter_table", "compare", "freqresp_band",
     "CrestDesign", "ExcitationLines", "excitation_lines", "min_crest_multisine", "multisine_realisations",
     "schroeder_multisine", "RecordResult", "identify_record", "ModeratedNoise", "moderated_noise",
-    "Disturbance", "DisturbanceResult", "disturbances",
+    "Disturbance", "DisturbanceResult", "disturbances", "Inspection", "LineClass", "inspect",
 ]

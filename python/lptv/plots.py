@@ -689,3 +689,74 @@ def compare(cmp, *, ax=None, unit: str = ""):
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     return ax
+
+
+def inspection(insp, *, hz: bool = False, fig=None):
+    """What :func:`lptv.inspect` found: the input's repeat residue r(L) against the lag with the
+    period marked, and the output's spectrum of the mean period by class of line (excited,
+    sidebands, odd and even detection lines, elsewhere) over its noise level.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> k = np.arange(2000)
+    >>> u = np.cos(2 * np.pi * 3 * k / 200) + np.cos(2 * np.pi * 7 * k / 200)
+    >>> fig = lptv.plots.inspection(lptv.inspect(u=u, y=0.5 * u + 0.01 * np.sin(k), fs=100.0))
+    >>> fig.axes[0].get_title()
+    'the input repeats every 2.00 s (200 samples)'
+    """
+    from .inspection import Inspection
+    from ._validate import as_bool
+
+    if not isinstance(insp, Inspection):
+        raise ValueError(f"insp must be an lptv.Inspection (from lptv.inspect), got {type(insp).__name__}")
+    hz = as_bool(hz, "hz")
+    if fig is None:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(6.4, 6.4 if insp.repeats else 3.2), layout="constrained")
+    axes = fig.subplots(2 if insp.repeats else 1, 1, squeeze=False)[:, 0]
+    ax = axes[0]
+    lag = insp.lags[1:]
+    x = lag / insp.fs if insp.fs else lag
+    ax.semilogy(x, np.maximum(insp.repeat[1:], 1e-12), lw=0.8, color="C0", label="input: r(L)")
+    from .inspection import REPEAT_LIMIT
+
+    ax.axhline(REPEAT_LIMIT, color="C3", ls="--", lw=1, label=f"limit of a period ({REPEAT_LIMIT:g})")
+    if insp.repeats:
+        L = insp.input_period_samples
+        for m in range(1, insp.max_period_samples // L + 1):
+            ax.axvline(m * L / insp.fs if insp.fs else m * L, color="C2", lw=0.8, alpha=0.6)
+        ax.set_title(f"the input repeats every {insp.seconds(L)}", fontsize="medium")
+    else:
+        ax.set_title(f"the input does not repeat up to {insp.seconds(insp.max_period_samples)}", fontsize="medium")
+    ax.set_xlabel("lag L (s)" if insp.fs else "lag L (samples)")
+    ax.set_ylabel("r(L): share of the power not repeated")
+    ax.legend(fontsize="small", loc="lower right")
+    ax.grid(True, alpha=0.3)
+    if not insp.repeats:
+        return fig
+    ax = axes[1]
+    lines = insp.spectrum_lines
+    w0 = insp.w0
+    xs = (lambda ls: _freq_axis(ls, w0, hz)[0]) if w0 else (lambda ls: np.asarray(ls))
+    label = _freq_axis(lines, w0, hz)[1] if w0 else "line (cycles per period)"
+    p = 10 * np.log10(np.maximum(np.abs(insp.Y) ** 2, 1e-300))
+    ax.plot(xs(lines), 10 * np.log10(np.maximum(insp.noise_y, 1e-300)), "-", color="k", lw=0.8,
+            label="output noise (mean of the periods)")
+    ax.plot(xs(lines), 10 * np.log10(np.maximum(insp.noise_y * insp.threshold, 1e-300)), "--", color="k",
+            lw=0.6, label="line test threshold")
+    groups = [("excited", insp.lines, "C0", "o")] + [
+        (c.name, c.lines, color, mk) for c, color, mk in
+        zip(insp.classes, ("C1", "C3", "C2", "0.6"), ("s", "v", "^", "."))]
+    for name, ls, color, mk in groups:
+        if ls.size:
+            ax.plot(xs(ls), p[ls - 1], mk, ms=3.5 if mk != "." else 2.5, color=color, ls="none",
+                    label=f"{name} ({ls.size})")
+    ax.set_xlabel(label)
+    ax.set_ylabel("output power (dB)")
+    ax.set_title(f"output of the mean of {insp.periods - insp.transient_periods} periods by class of line",
+                 fontsize="medium")
+    ax.legend(fontsize="small", ncol=2)
+    ax.grid(True, alpha=0.3)
+    return fig

@@ -111,7 +111,8 @@ def test_transient_in_the_first_period_warns_and_skip_periods_cures_it(tmp_path,
     assert lptv.check_record(u0, y0, warn=False).ok  # steady state: no false alarm
     src = write_csv(tmp_path / "t.csv", u.ravel(), y.ravel())
     rc, out, err = run_cli(capsys, src, "--na", 2, "--nb", 0, "--fs", FS, "--period", T0, "--out", tmp_path / "o")
-    assert rc == 0 and "warning: the first period differs" in out
+    # the transient left in: warned, and the verdict rejects the fit it spoils (exit status 3)
+    assert rc == 3 and "warning: the first period differs" in out and "verdict: MODEL ERRORS" in out
     rc, out, err = run_cli(capsys, src, "--na", 2, "--nb", 0, "--fs", FS, "--period", T0, "--skip-periods", 1,
                            "--out", tmp_path / "o")
     assert rc == 0 and "first period differs" not in out and "7 periods of 1000" in out
@@ -139,7 +140,7 @@ def test_the_wrong_model_is_rejected_whatever_the_fraction_on_all_lines(record, 
     # the same in the command: the case of the issue
     src = write_csv(tmp_path / "r.csv", u.ravel(), y.ravel())
     rc, out, err = run_cli(capsys, src, "--na", 2, "--nb", 0, "--periods", 8, "--ts", 0.01, "--out", tmp_path / "o")
-    assert rc == 0 and "verdict: MODEL ERRORS: the model is rejected" in out
+    assert rc == 3 and "verdict: MODEL ERRORS: the model is rejected" in out     # exit status 3: rejected
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert s["model_ok"] is False
     errors = s["model_errors"]

@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import NumericalError, distortion, identify, parameter_table, plots
+from lptv.apps.options import verdict_status
 from lptv.apps.report import Report, model_figures, write_fit
 
 
@@ -138,7 +139,7 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
         print(f"warning: {msg}")
     summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit, referred)
     failed = write_fit(out, res.model, summary, lambda: _report(src, meas, dist, res, summary))
-    return _fail(failed[0] or src, failed[1]) if failed else 0
+    return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)
 
 
 def _levels(dist):

@@ -2,6 +2,7 @@
 
     lptv demo [--out DIR] [--monte-carlo R] [--quick]     the paper's simulation example
     lptv demo lecture [--out DIR] [--quick]               the lecture's cases
+    lptv inspect FILE [--input NAME --output NAME]        a record's period, transient, excited lines
     lptv identify FILE --na 2 --nb 1 ...                  a model from your own measurements
     lptv identify FILES... [--workers N | --scheduler ADDRESS]   many files, one row each
     lptv identify FILES... --joint --na 2 --nb 1 ...       records of one system, one model
@@ -78,6 +79,9 @@ def main(argv=None) -> int:
     from lptv.apps import fileid
 
     fileid.add_parser(sub)
+    from lptv.apps import inspectrec
+
+    inspectrec.add_parser(sub)
     from lptv.apps import montecarlo
 
     montecarlo.add_parser(sub)
@@ -132,10 +136,12 @@ def _run(parser, args) -> int:
         from lptv.apps import demo
 
         return demo.run(args)
-    from lptv.apps import choose, fileid, montecarlo
+    from lptv.apps import choose, fileid, inspectrec, montecarlo
 
     if args.command == "identify":
         return fileid.run(args)
+    if args.command == "inspect":
+        return inspectrec.run(args)
     if args.command == "montecarlo":
         return montecarlo.run(args)
     if args.command == "select":

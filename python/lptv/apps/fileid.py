@@ -20,8 +20,14 @@ checked uniform) or its stored ``fs`` / ``dt`` / ``Ts``, said in the first line 
 The period comes from ``--w0`` (rad/s), ``--period`` (s), the file's ``w0`` or, in discrete time,
 from ``--ts`` and the samples per period. The command writes ``model.json`` (readable by
 :meth:`lptv.Model.load`), ``report.html`` with the validation figures, and ``summary.json``, and
-prints the validation verdict. Problems with the file or the options end in a one-line error
-and exit status 2.
+prints the validation verdict. Exit status: 0 when the verdict calls the model consistent with
+the data, 3 when it does not (MODEL ERRORS, or NOT DETERMINED), 2 for a file or options that
+cannot be used (a one-line error), 1 for a computation that failed. Before the fit the record
+is diagnosed as ``lptv inspect`` does: a period (``--period``, ``--w0``, ``--periods``, the
+file's) that is not the one the input repeats at, nor a multiple of it, an ``--fs`` that
+contradicts the file's time, and a record that does not repeat are errors that name the cause
+(``--no-period-check`` fits the record as cut anyway, with the contradiction as a warning);
+so are the fit's refusals of an output that shows no periodic response.
 
 Example (the paper's simulation example as a measurement file, then its identification)::
 
@@ -42,6 +48,8 @@ import numpy as np
 from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_zeros, identify, lti_table,
                   parameter_table, plots, read_measurements, simulate)
 from lptv.apps.options import MAX_EXPANDED, bounded_range, in_option_terms, integer, output_folder
+from lptv.apps import inspectrec
+from lptv.apps.options import verdict_status
 from lptv.apps.report import Report, write_fit
 from lptv import METHODS
 from lptv.measurements import FileError
@@ -148,7 +156,11 @@ Identify an LPTV model from P >= 2 measured steady-state periods of input u and 
   .mat  MATLAB v5 or v7.3: variables as in .npz
 A long record is split into periods by --periods, or by fs (--fs / --dt, else the file's time
 or stored fs) and the period (--period / --w0); the first line of the output says which fs.
-Writes model.json, report.html and summary.json, and prints the validation verdict.
+Writes model.json, report.html and summary.json, and prints the validation verdict. The period
+is checked against the one the input repeats at (lptv inspect FILE shows it; --no-period-check
+skips the check). Exit status 0: the model is consistent with the data; 3: the verdict finds
+model errors (or the data do not determine the model); 2: a file or option that cannot be used;
+1: a computation that failed.
 Several files (or --workers / --scheduler) make a batch: one row per file in results.csv,
 each model in models/, the fits on local processes or a Dask cluster. With --joint the files
 are records of one system (same period) fitted together into one model and one report."""
@@ -221,6 +233,10 @@ def add_parser(sub):
     p.add_argument("--remove-disturbances", action="store_true",
                    help="find the sinusoids that are not periodic in the record (off the period's grid, "
                    "such as mains hum) and subtract them before the fit (lptv.disturbances; one record)")
+    p.add_argument("--no-period-check", action="store_true",
+                   help="fit the record as the options cut it even where the record says otherwise (a period "
+                   "or --fs that contradicts the one found in the data, a record that does not repeat); "
+                   "the contradiction is then printed as a warning")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
@@ -251,9 +267,44 @@ OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_ite
 """The arguments of lptv.identify and the options that set them, for the messages."""
 
 
-def _fail(name, problem) -> int:
+def _fail(name, problem, status=2) -> int:
     print(f"lptv identify: error: {name}: {in_option_terms(_one_line(problem), OPTION_NAMES)}", file=sys.stderr)
-    return 2
+    return status
+
+
+def _read_failure_cause(diag, args, error):
+    """A reader's error with the record's own diagnosis where that names the cause: an fs or a
+    period (in s) that contradicts the record replaces it; for a record split by --periods or
+    stored as periods x samples arrays, where the reader's count is itself the news, the cause
+    is added to it."""
+    text = str(error)
+    if diag is None or args.no_period_check:
+        return text
+    fs = args.fs if args.fs is not None else (1 / args.dt if args.dt else None)
+    if fs is None and args.periods is None:
+        fs = diag.file_fs
+    period = inspectrec.period_option(args)
+    n, by_count = None, False
+    if fs and period:
+        n = fs * period[1]
+    elif args.periods:
+        n, by_count = diag.samples / args.periods, True
+    cause = inspectrec.setup_problem(diag, args, n)
+    split = re.search(r"whole|drop \d+ samples|samples per period|less than one period|period is needed|"
+                      r"--periods is required|needs the period|: give ", text)
+    if cause is None:
+        if n is None and diag.repeats and split:
+            hint = f"--period {diag.period:.12g}" if diag.period is not None else f"--periods {diag.periods}"
+            return f"{text}; the input repeats every {diag.seconds(diag.period_samples)}: {hint}"
+        return text
+    if cause.startswith(("--fs", "--dt")):
+        return cause
+    if not diag.repeats:
+        # a reader's count on arrays stored the other way round, or on a record too short, stands
+        return cause if split and diag.stored_period is None else text
+    if by_count or diag.stored_period is not None:
+        return f"{text}; {cause}"
+    return cause
 
 
 # ------------------------------------------------------------------------------ running
@@ -287,6 +338,7 @@ def run(args) -> int:
 
         return manyid.run(args)
     src = args.files[0]
+    diag = meas = None
     try:
         output_folder(args.out)
     except OSError as e:
@@ -299,7 +351,17 @@ def run(args) -> int:
         for opt in ("na", "nb", "max_iter"):
             integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         positive(args.tol, "--tol")
-        meas = read_record(src, args, realisations=True)
+        diag = inspectrec.diagnose(src, args)
+        try:
+            meas = read_record(src, args, realisations=True)
+        except FileError as e:
+            raise FileError(_read_failure_cause(diag, args, e)) from None
+        if meas.realisations:
+            diag = None
+        checked = inspectrec.setup_problem(diag, args, meas.u.shape[-1])
+        if checked and not args.no_period_check:
+            raise FileError(checked)
+        output_note = inspectrec.output_period_note(diag, meas.u.shape[-1])
         if args.discrete and args.ts is not None:
             raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
         if args.discrete and meas.fs is None:
@@ -330,10 +392,17 @@ def run(args) -> int:
                            seed=0, noise=args.noise,
                            disturbances="remove" if args.remove_disturbances else None)
             Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
-    except (FileError, ValueError, NumericalError) as e:
+    except NumericalError as e:
+        return _fail(src, e, status=1)
+    except (FileError, ValueError) as e:
+        if not isinstance(e, FileError) and diag is not None and meas is not None and not args.no_period_check \
+                and re.match(r"(u|y): |lines: only", str(e)):
+            e = inspectrec.failure_cause(diag, args, meas.u.shape[-1]) or e
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
-    extra = list(record.messages) + [str(w.message) for w in caught if str(w.message) not in res.warnings]
+    extra = ([f"{checked} (kept by --no-period-check)"] if checked else []) \
+        + ([output_note] if output_note else []) + list(record.messages) \
+        + [str(w.message) for w in caught if str(w.message) not in res.warnings]
 
     P, N = meas.u.shape
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
@@ -351,7 +420,7 @@ def run(args) -> int:
               "periodic in the record may inflate the noise estimate; --remove-disturbances finds and removes it")
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
     failed = write_fit(out, res.model, summary, lambda: _report(src, meas, res, Y_pred, summary))
-    return _fail(failed[0] or src, failed[1]) if failed else 0
+    return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)
 
 
 def _prediction_gap_db(res, Y_pred):

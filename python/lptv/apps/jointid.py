@@ -22,6 +22,7 @@ import numpy as np
 
 from lptv import FrequencyData, NumericalError, identify, parameter_table, plots
 from lptv.apps.fileid import fundamental, parse_counts, parse_known, parse_lines, positive, read_record
+from lptv.apps.options import verdict_status
 from lptv.apps.report import Report, model_figures, write_fit
 from lptv.measurements import FileError
 
@@ -94,7 +95,7 @@ def run(args) -> int:
     failed = write_fit(out, model, summary, lambda: _report(records, res, summary))
     if failed:
         return _fail(failed[1] if failed[0] is None else f"{failed[0]}: {failed[1]}")
-    return 0
+    return verdict_status(res)
 
 
 def _experiment_rows(res, e):

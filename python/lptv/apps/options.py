@@ -27,6 +27,17 @@ MAX_EXPANDED = 2**26
 """The most values a range option (``--lines 1-N``) may expand to: the largest grid of the core."""
 
 
+MODEL_REJECTED = 3
+"""The exit status of ``lptv identify FILE`` when the verdict does not call the model consistent with
+the data (MODEL ERRORS, or NOT DETERMINED); 0 when it does, 2 for a file or options that cannot be
+used, 1 for a computation that failed."""
+
+
+def verdict_status(res) -> int:
+    """0 for a model the verdict calls consistent with the data, else :data:`MODEL_REJECTED`."""
+    return 0 if res.model_ok and res.undetermined is None else MODEL_REJECTED
+
+
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``prog: error: message`` on stderr, exit status 2 (the usage
     block stays in ``--help``)."""

@@ -1,0 +1,224 @@
+"""``lptv inspect FILE``: what a record holds before a model is fitted, and the command to fit one.
+
+Prints :meth:`lptv.Inspection.summary` (sampling, period, periods, transient, excitation, the
+output between the excited lines, the suggested ``lptv identify`` command) and writes
+``report.html`` (with the figure of :func:`lptv.plots.inspection`) and ``summary.json`` into
+``--out`` (default ``<file stem>-inspect/``). Exit status 0 when the record was inspected (a
+record that does not repeat included: the summary says so and names the one-record route),
+2 for a file or options that cannot be read.
+
+The same diagnosis names the cause of an error of ``lptv identify FILE`` (:func:`setup_problem`,
+:func:`failure_cause`): a period or a sampling frequency that contradicts the record, a record
+that does not repeat, an output that does not repeat with the input.
+
+Example::
+
+    lptv inspect rig.csv --input force --output displacement
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from lptv import inspect, plots
+from lptv.apps.options import in_option_terms, output_folder
+from lptv.apps.report import PLOTS_EXTRA, Report, write_json
+from lptv.measurements import FileError
+
+OPTION_NAMES = {"fs": "--fs", "dt": "--dt", "reach": "--reach"}
+
+_HELP = """\
+Looks at a record before any model is fitted: the sampling frequency (--fs / --dt, else the
+file's time column or stored fs, checked uniform), the period (the shortest lag at which the
+input repeats; the output's, when it repeats only every few of the input's periods), the whole
+periods and the samples left over, the start-up transient, the excited lines and their
+signal-to-noise ratios, and the output's power on the other lines: sidebands of the excited
+lines (time variation), odd and even detection lines (nonlinear distortion), elsewhere (noise or
+a disturbance). Ends with the lptv identify command the record asks for. Writes report.html
+(with a figure) and summary.json into --out."""
+
+
+def add_parser(sub):
+    p = sub.add_parser("inspect", help="look at a measurement file: period, transient, excited lines",
+                       description=_HELP, formatter_class=argparse.RawDescriptionHelpFormatter,
+                       epilog="examples:\n"
+                              "  lptv inspect rig.csv --input force --output displacement\n"
+                              "  lptv inspect record.npz --fs 100\n"
+                              "  lptv inspect rig.csv --input force --output displacement --reach 3")
+    p.add_argument("file", metavar="FILE", help="measurements: .csv, .npz or .mat (as for lptv identify)")
+    p.add_argument("--input", metavar="NAME", help="the input channel (default u; matched up to case and a unit)")
+    p.add_argument("--output", metavar="NAME", help="the output channel (default y)")
+    p.add_argument("--time", metavar="NAME", help="a time column or variable (default: one named t, time, time [s] ...)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--fs", type=float, help="sampling frequency in Hz (default: the file's)")
+    g.add_argument("--dt", type=float, help="sampling time in s")
+    p.add_argument("--reach", type=int, metavar="K",
+                   help="count sidebands up to +-K lines from an excited line (default: the room the design leaves)")
+    p.add_argument("--out", help="output folder (default: <file stem>-inspect/)")
+    return p
+
+
+def _fail(name, problem) -> int:
+    text = " ".join(str(problem).split()) or type(problem).__name__
+    print(f"lptv inspect: error: {name}: {in_option_terms(text, OPTION_NAMES)}", file=sys.stderr)
+    return 2
+
+
+def run(args) -> int:
+    src = args.file
+    try:
+        output_folder(args.out)
+    except OSError as e:
+        return _fail(e.filename or args.out, e.strerror or e)
+    try:
+        insp = inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt, reach=args.reach)
+    except ValueError as e:
+        return _fail(src, e)
+    print(insp.summary())
+    out = Path(args.out) if args.out else Path(Path(src).stem + "-inspect")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        write_json(out / "summary.json", summary(insp))
+        report(insp).write(out)
+    except OSError as e:
+        return _fail(e.filename or out, e.strerror or e)
+    except ImportError:
+        print(f"lptv inspect: {PLOTS_EXTRA}", file=sys.stderr)
+        return 0
+    print(f"wrote {out / 'report.html'}, {out / 'summary.json'}")
+    return 0
+
+
+def summary(insp) -> dict:
+    """The findings as plain values (summary.json)."""
+    return {
+        "file": insp.source, "format": insp.format, "input": insp.input, "output": insp.output,
+        "samples": insp.samples, "fs": insp.fs, "fs_source": insp.fs_source, "file_fs": insp.file_fs,
+        "repeats": insp.repeats, "input_period_samples": insp.input_period_samples,
+        "period_samples": insp.period_samples, "input_period_exact_samples": insp.input_period_exact, "period": insp.period,
+        "w0": insp.w0, "repeat_ratio": insp.repeat_ratio, "output_repeats": insp.output_repeats,
+        "periods": insp.periods, "leftover_samples": insp.leftover, "transient_periods": insp.transient_periods,
+        "transient_ratios": insp.transient_ratios.tolist(), "transient_limit": insp.transient_limit,
+        "excited_lines": insp.lines.tolist(), "spacing": insp.spacing, "weak_input_lines": insp.weak_input_lines.tolist(),
+        "input_snr_db": insp.input_snr_db.tolist(), "output_snr_db": insp.output_snr_db.tolist(),
+        "reach": insp.reach, "time_variation_reach": insp.time_variation_reach,
+        "classes": {c.name: {"lines": int(c.lines.size), "above_noise": c.above.tolist(),
+                             "excess_db": c.excess_db, "strongest_db": c.level_db} for c in insp.classes},
+        "notes": list(insp.notes), "command": insp.command,
+    }
+
+
+def report(insp) -> Report:
+    rep = Report(f"lptv inspect: {Path(insp.source).name}")
+    rep.paragraph("What the record holds before any model is fitted, from its samples alone "
+                  "(METHOD.md section 18 gives the criteria).")
+    rep.preformatted(insp.summary())
+    fig = plots.inspection(insp)
+    caption = ("Top: the input's repeat residue r(L), the share of its power that the record shifted by L "
+               "samples does not reproduce (0: repeats exactly; about 1: unrelated), with the limit a period "
+               "must meet; the period found and its multiples are marked.")
+    if insp.repeats:
+        caption += (" Bottom: the output spectrum of the mean of the steady periods, each line marked by its "
+                    "class, over the noise level of that mean and the line test's threshold (noise alone "
+                    f"crosses it on any of the {insp.spectrum_lines.size} lines with a chance of 1 %).")
+    rep.figure(fig, "inspection.png", caption)
+    return rep
+
+
+# ------------------------------------------------------------------------------ lptv identify's diagnosis
+
+def period_option(args):
+    """How the options state the period: ('--period 4', seconds) or ('--w0 1.2', seconds), or None."""
+    if args.period is not None and args.period > 0:
+        return f"--period {args.period:g}", float(args.period)
+    if args.w0 is not None and args.w0 > 0:
+        return f"--w0 {args.w0:g}", 2 * np.pi / float(args.w0)
+    return None
+
+
+def diagnose(src, args):
+    """:func:`lptv.inspect` on the file as the options name its channels and fs; None when the
+    file cannot be read that way (the reader's own error then stands)."""
+    try:
+        return inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt)
+    except (ValueError, OSError):
+        return None
+
+
+def setup_problem(insp, args, samples_per_period=None):
+    """The first contradiction between the options and the record, as a one-line message, or None:
+    an fs that contradicts the file's time; a period (given, or the split's samples per period)
+    that is not the one the record repeats at (nor a multiple); a record that does not repeat."""
+    if insp is None:
+        return None
+    given_fs = f"--fs {args.fs:g}" if args.fs is not None else (f"--dt {args.dt:g}" if args.dt is not None else None)
+    if given_fs and insp.file_fs is not None and not np.isclose(insp.fs, insp.file_fs, rtol=1e-6, atol=0):
+        return (f"{given_fs} contradicts the file's {insp.file_fs_source} ({insp.file_fs:.10g} Hz): leave "
+                f"{given_fs.split()[0]} out, or name the time's unit (time [ms]), or --no-period-check to use it anyway")
+    if not insp.repeats:
+        return not_repeating(insp)
+    if samples_per_period is None:
+        return None
+    if insp.agrees_with(samples_per_period):
+        return None
+    return wrong_period(insp, args, samples_per_period)
+
+
+def not_repeating(insp) -> str:
+    return (f"the record does not repeat at any period up to {insp.seconds(insp.max_period_samples, 'half the record')}"
+            f": the input's best lag leaves {100 * min(insp.repeat_ratio, 9.99):.3g} % of its power unexplained; it "
+            "is not a record of periods: identify it as one record with its transient (lptv.identify_record in "
+            "Python), or --no-period-check to fit it as periods anyway")
+
+
+def wrong_period(insp, args, samples_per_period) -> str:
+    N = insp.period_samples
+    found = f"the input repeats every {insp.seconds(insp.input_period_samples)}"
+    if N != insp.input_period_samples:
+        found += f" and the output every {insp.seconds(N)}"
+    opt = period_option(args)
+    if insp.fs is not None:
+        fix = f"use --period {N / insp.fs:.12g}"
+    else:
+        fix = f"use --periods {insp.periods}" + (" with the first samples dropped" if insp.leftover else "")
+    if opt is not None:
+        said = f"not every {opt[1]:g} s ({opt[0]}"
+        said += f", {samples_per_period:g} samples)" if insp.fs is not None else ")"
+    elif args.periods is not None:
+        said = f"not every {samples_per_period:g} samples (--periods {args.periods})"
+    elif insp.stored_period is not None:
+        said = f"not every {samples_per_period:g} samples (the file's periods x samples arrays)"
+        fix = "store the record as one long vector, or as periods of that length"
+    else:
+        said = f"not every {insp.seconds(samples_per_period)} (the file's w0 or fs)"
+    return f"{found}, {said}: {fix} (or --no-period-check to keep yours)"
+
+
+def output_period_note(insp, samples_per_period):
+    """A warning when the record is cut at the input's period (or a multiple) that the output
+    does not repeat at: its period is a multiple of the input's (the system's period)."""
+    if insp is None or not insp.repeats or not insp.agrees_with(samples_per_period) \
+            or insp.output_agrees_with(samples_per_period):
+        return None
+    fix = f"--period {insp.period:.12g}" if insp.period is not None else f"periods of {insp.period_samples} samples"
+    return (f"the output repeats only every {insp.seconds(insp.period_samples)}, every "
+            f"{insp.period_samples // insp.input_period_samples} of the input's periods: the system's period is "
+            f"probably that one ({fix})")
+
+
+def failure_cause(insp, args, samples_per_period=None):
+    """The likely cause of a failure of the fit on a record cut into periods (a refusal of the
+    data diagnostics: no input or output variation above the noise), or None: the record's
+    own problem when it has one, an output that does not repeat with the input."""
+    problem = setup_problem(insp, args, samples_per_period)
+    if problem or insp is None or not insp.repeats:
+        return problem
+    if not insp.output_repeats:
+        return (f"the output does not repeat with the input (every {insp.seconds(insp.period_samples)}): "
+                f"{100 * min(insp.output_repeat_ratio, 9.99):.3g} % of its power does not repeat; it shows no "
+                "periodic response above its noise (a dead or unconnected output channel, the wrong output, or "
+                "a response far below the noise)")
+    return None
