@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,8 +40,8 @@ from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, f
 FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
 _MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
                    "int64", "uint64"}
-__all__ = ["FileError", "Measurements", "RecordCheck", "RecordWarning", "check_record", "read_measurements",
-           "samples_per_period"]
+__all__ = ["FileError", "Measurements", "RecordCheck", "RecordWarning", "check_record", "memory_budget",
+           "read_measurements", "samples_per_period"]
 
 
 def _one_line(e):
@@ -97,7 +98,7 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
                       dt: Optional[float] = None, period: Optional[float] = None,
                       trim: bool = False, skip_periods: int = 0, u: Optional[str] = None,
                       y: Optional[str] = None, time: Optional[str] = None,
-                      realisations: bool = False) -> Measurements:
+                      realisations: bool = False, detrend: bool = False) -> Measurements:
     """Read u, y (shape (P, N)) and an optional w0 from a CSV, NPZ or MATLAB file.
 
     Parameters
@@ -135,6 +136,10 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         (each realisation may also be one long vector, shape (M, samples), split as above).
         ``u`` and ``y`` of the result then have shape (M, P, N); ``skip_periods`` drops periods
         of every realisation. Without it such variables are refused, naming this option.
+    detrend : bool
+        Take a linear drift out of each channel (of each realisation): the least-squares trend
+        across the periods with the mean period free (:func:`check_record` reports a drift), so
+        that each period's shape is kept. Done after ``skip_periods``.
 
     Raises :class:`FileError` with a message naming the problem (not the file).
 
@@ -159,7 +164,7 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     """
     path = Path(as_path(path))
     o = read_options(periods=periods, fs=fs, dt=dt, period=period, trim=trim, skip_periods=skip_periods,
-                     u=u, y=y, time=time)
+                     u=u, y=y, time=time, detrend=detrend)
     periods, fs, dt, period, trim, skip_periods = (o[k] for k in ("periods", "fs", "dt", "period", "trim",
                                                                   "skip_periods"))
     names = {"u": o["u"] or "u", "y": o["y"] or "y", "time": o["time"]}
@@ -215,6 +220,8 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
             raise FileError(f"--skip-periods {skip_periods} leaves {P - skip_periods} of "
                             f"{P} periods; the noise model needs at least 2")
         u_p, y_p = u_p[..., skip_periods:, :], y_p[..., skip_periods:, :]
+    if o["detrend"]:
+        u_p, y_p = (np.stack([detrended(r) for r in x]) if x.ndim == 3 else detrended(x) for x in (u_p, y_p))
     if w0 is None and split.period is not None:
         w0 = 2 * np.pi / split.period      # the period given
     return Measurements(u=u_p, y=y_p, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods,
@@ -224,11 +231,11 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
 def read_options(**kw) -> dict:
     """The keyword arguments of :func:`read_measurements` (all but the path), checked and
     converted: FileError naming the first bad one (also for a name that is not one of them)."""
-    known = ("periods", "fs", "dt", "period", "trim", "skip_periods", "u", "y", "time")
+    known = ("periods", "fs", "dt", "period", "trim", "skip_periods", "u", "y", "time", "detrend")
     for k in kw:
         if k not in known:
             raise FileError(f"{k!r} is not an argument of lptv.read_measurements (one of {', '.join(known)})")
-    o = dict(dict.fromkeys(known), trim=False, skip_periods=0)
+    o = dict(dict.fromkeys(known), trim=False, skip_periods=0, detrend=False)
     o.update(kw)
     return dict(
         periods=as_optional(o["periods"], _option, as_int, "--periods", minimum=1),
@@ -237,6 +244,7 @@ def read_options(**kw) -> dict:
         period=as_optional(o["period"], _option, as_float, "--period", minimum=0.0, open_min=True,
                            what="a positive number"),
         trim=_option(o["trim"], as_bool, "--trim"), skip_periods=_option(o["skip_periods"], as_int, "--skip-periods"),
+        detrend=_option(o["detrend"], as_bool, "--detrend"),
         u=channel_name(o["u"], "u"), y=channel_name(o["y"], "y"), time=channel_name(o["time"], "time"))
 
 
@@ -388,6 +396,12 @@ def _read_csv(path, names):
 def _csv_text(path):
     """A CSV file's text: UTF-8 (with or without a byte-order mark) or UTF-16 with its mark;
     UTF-16 without a mark, or bytes that are no text, named as such."""
+    # a CSV's values take, once parsed, a few times their text (a Python float and its list slot)
+    size = path.stat().st_size
+    if 4 * size > memory_budget():
+        raise FileError(f"the CSV file holds {_bytes(size)}, more than a quarter of lptv's memory budget of "
+                        f"{_bytes(memory_budget())} (half the machine's memory, or LPTV_MEMORY_BUDGET): store "
+                        "the record as NPZ or MAT (read without the text's overhead), or cut it")
     data = path.read_bytes()
     head = data[:4096]
     if head[:2] not in (b"\xff\xfe", b"\xfe\xff") and b"\x00" in head:
@@ -607,6 +621,64 @@ def _file_fs(arrays, names, t):
     return found
 
 
+# ------------------------------------------------------------------------------ memory budget
+
+def memory_budget() -> int:
+    """The most bytes a measurement file's arrays may take once read (as float64): the
+    environment variable ``LPTV_MEMORY_BUDGET`` (bytes, or with a suffix K, M, G, T: powers of
+    1024), else half of this machine's physical memory. A file whose headers declare more (an
+    NPZ's array headers, a MAT file's variable list, an HDF5 dataset's shape, a CSV's size) is
+    refused before any of it is read, with the sizes; the allocator is never the one to say no."""
+    text = os.environ.get("LPTV_MEMORY_BUDGET", "").strip()
+    if text:
+        scale = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
+        unit = text[-1].upper()
+        try:
+            value = float(text[:-1]) * scale[unit] if unit in scale else float(text)
+        except ValueError:
+            raise FileError(f"LPTV_MEMORY_BUDGET must be a number of bytes (e.g. 4G), got {text!r}") from None
+        if not (np.isfinite(value) and value > 0):
+            raise FileError(f"LPTV_MEMORY_BUDGET must be positive, got {text!r}")
+        return int(value)
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2
+    except (ValueError, OSError, AttributeError):     # no sysconf: 8 GiB
+        return 8 << 30
+
+
+def _bytes(n) -> str:
+    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n:.0f} bytes"
+
+
+def _within_budget(declared, what):
+    """declared: {name: number of values}; FileError when they exceed the budget as float64."""
+    total = 8 * sum(int(v) for v in declared.values())
+    budget = memory_budget()
+    if total > budget:
+        big = max(declared, key=lambda k: declared[k])
+        raise FileError(f"{what} declares {_bytes(total)} of samples ({big!r}: {int(declared[big])} values), "
+                        f"more than lptv's memory budget of {_bytes(budget)} (half the machine's memory, or "
+                        "LPTV_MEMORY_BUDGET): nothing was read; cut the record, or raise the budget")
+
+
+def _npz_sizes(path, members):
+    """{array name: number of values} from the headers of an NPZ's members, nothing else read."""
+    import zipfile
+
+    out = {}
+    with zipfile.ZipFile(path) as z:
+        for name in members:
+            with z.open(name + ".npy") as f:
+                version = np.lib.format.read_magic(f)
+                shape = (np.lib.format.read_array_header_1_0(f) if version == (1, 0)
+                         else np.lib.format.read_array_header_2_0(f))[0]
+            out[name] = int(np.prod(shape, dtype=object))
+    return out
+
+
 def _read_npz(path, names):
     try:
         npz = np.load(path, allow_pickle=False)
@@ -618,7 +690,14 @@ def _read_npz(path, names):
         try:
             files = list(npz.files)
             u, y, t, extra = _wanted(names, files, "array", lambda: listing({k: npz[k].shape for k in files}))
-            arrays = {k: npz[k] for k in {u, y, *extra, *([t] if t else [])}}
+            wanted = {u, y, *extra, *([t] if t else [])}
+            try:
+                sizes = _npz_sizes(path, wanted)
+            except (KeyError, ValueError, OSError):
+                sizes = None            # not a plain .npy member: np.load's own error below
+            if sizes is not None:
+                _within_budget(sizes, "the NPZ file")
+            arrays = {k: npz[k] for k in wanted}
         except FileError:
             raise
         except Exception as e:
@@ -633,6 +712,12 @@ def _read_mat(path, names):
         return _read_mat73(path, names), "MAT v7.3"
     import scipy.io
 
+    try:
+        declared = {name: int(np.prod(shape, dtype=object)) for name, shape, _ in scipy.io.whosmat(path)}
+    except Exception:  # noqa: BLE001 - loadmat names the damage below
+        declared = None
+    if declared:
+        _within_budget(declared, "the MATLAB file")
     try:
         d = scipy.io.loadmat(path, squeeze_me=False)
     except Exception as e:  # scipy raises a zoo of types for a damaged or foreign file
@@ -653,7 +738,10 @@ def _read_mat73(path, names):
             # MATLAB's P x N is N x P in HDF5: the shapes as MATLAB shows them
             shown = listing({k: getattr(f[k], "shape", None) and f[k].shape[::-1] for k in avail})
             u, y, t, extra = _wanted(names, avail, "variable", shown)
-            arrays = {name: _h5_variable(f, name) for name in {u, y, *extra, *([t] if t else [])}}
+            wanted = {u, y, *extra, *([t] if t else [])}
+            _within_budget({k: int(np.prod(getattr(f[k], "shape", ()) or (1,), dtype=object)) for k in wanted},
+                           "the MATLAB v7.3 file")
+            arrays = {name: _h5_variable(f, name) for name in wanted}
     except FileError:
         raise
     except Exception as e:
@@ -715,8 +803,43 @@ def _transient_ratio(x):
     return num / (s2 * (1.0 + 1.0 / (P - 1)))
 
 
+DRIFT_T = 8.0
+"""A drift is reported when its slope stands this many standard errors from zero ..."""
+DRIFT_FRACTION = 0.25
+"""... and explains at least this share of the periods' deviations from their mean."""
+
+
+def _drift(x):
+    """(slope per period, its t statistic, the share of the deviations it explains) of a linear
+    trend through the record x (P, N): x[p, n] = m[n] + beta (p + n / N) + noise, m free, so that
+    the deviations from the mean period are beta (p - (P - 1) / 2) + noise, whatever m is."""
+    P, N = x.shape
+    dev = x - x.mean(axis=0)
+    c = np.arange(P) - (P - 1) / 2.0
+    scc = N * float(c @ c)
+    beta = float(c @ dev.sum(axis=1)) / scc
+    total = float(np.sum(dev ** 2))
+    explained = beta ** 2 * scc
+    dof = N * (P - 1) - 1
+    if dof < 1 or total <= 0:
+        return beta, 0.0, 0.0
+    s2 = max(total - explained, 1e-300 * total) / dof
+    return beta, abs(beta) / np.sqrt(s2 / scc), explained / total
+
+
+def detrended(x, beta=None):
+    """x (P, N) without its linear trend across the periods (:func:`_drift`'s beta), each
+    period's shape and the mean level kept."""
+    x = np.asarray(x, dtype=float)
+    P, N = x.shape
+    if beta is None:
+        beta = _drift(x)[0]
+    t = np.arange(P)[:, None] + np.arange(N)[None, :] / N
+    return x - beta * (t - t.mean())
+
+
 def check_record(u, y, *, warn: bool = True, spread_limit: float = 0.1) -> RecordCheck:
-    """Look for a start-up transient and for periods cut at the wrong length.
+    """Look for a start-up transient, a drift and for periods cut at the wrong length.
 
     The transient check compares the first period with the mean of the others, relative to the
     noise the other periods show: ``r = mean((x_1 - mean_{p>1} x_p)^2) / (s^2 (1 + 1/(P-1)))``
@@ -725,6 +848,12 @@ def check_record(u, y, *, warn: bool = True, spread_limit: float = 0.1) -> Recor
     ``sqrt(2 / N + 2 / (N (P - 2)))`` (white noise); a first period above 1 + 6 such deviations (and
     above 1.5) is reported with the advice to drop it (``skip_periods=1`` / ``--skip-periods 1``).
     It needs P >= 3.
+
+    The drift check fits a linear trend through each channel across the periods (the mean period
+    free): a slope more than ``DRIFT_T`` = 8 standard errors from zero that explains more than
+    ``DRIFT_FRACTION`` = 25 % of the periods' deviations from their mean is reported as a drift,
+    with the advice to detrend (``detrend=True`` of :func:`read_measurements`, ``--detrend``);
+    the first period is then judged a transient only if it still differs once the drift is out.
 
     The period check: a periodic input (a generator's multisine) cut at its period repeats up to
     its noise; ``input_spread`` (the mean variance over the periods over the power of the mean
@@ -764,7 +893,28 @@ def check_record(u, y, *, warn: bool = True, spread_limit: float = 0.1) -> Recor
     if P >= 3:
         ratio = max(_transient_ratio(u), _transient_ratio(y))
         limit = max(1.0 + 6.0 * np.sqrt(2.0 / N + 2.0 / (N * (P - 2))), 1.5)
-        if ratio > limit:
+        drifts = {}
+        for name, x in (("input", u), ("output", y)):
+            beta, t, share = _drift(x)
+            if t > DRIFT_T and share > DRIFT_FRACTION:
+                drifts[name] = (beta, t, share, x)
+        transient = ratio > limit
+        if drifts:
+            # what is left of the first period's difference once the drift is gone
+            left = max(_transient_ratio(detrended(x, beta)) if name in drifts else _transient_ratio(x)
+                       for name, x, beta in (("input", u, drifts.get("input", (0,))[0]),
+                                             ("output", y, drifts.get("output", (0,))[0])))
+            transient = left > limit
+            if transient:   # a transient as well: the drift must show without the first period
+                drifts = {k: v for k, v in drifts.items()
+                          if P >= 4 and _drift(v[3][1:])[1] > DRIFT_T and _drift(v[3][1:])[2] > DRIFT_FRACTION}
+        for name, (beta, t, share, _) in drifts.items():
+            msgs.append(f"the {name} drifts through the record: a linear trend of {beta:.3g} per period "
+                        f"({t:.0f} times its standard error, {100 * share:.0f} % of the periods' deviations from "
+                        "their mean), a drift rather than a start-up transient; remove it with detrend=True "
+                        "(--detrend), which takes the trend out and keeps each period's shape, or find its cause "
+                        "(an offset that creeps, a temperature)")
+        if transient:
             msgs.append(f"the first period differs from the mean of the others by {ratio:.3g} times what "
                         f"the noise explains (steady state: about 1): a start-up transient? Drop it with "
                         f"skip_periods=1 (--skip-periods 1)")

@@ -137,3 +137,104 @@ def test_montecarlo_of_a_model_whose_bound_is_singular_is_one_line(tmp_path, cap
                    "--runs", "2", "--periods", "4", "--workers", "1", "--out", str(tmp_path / "mc")])
     err = capsys.readouterr().err
     assert rc == 1 and err.count("\n") == 1 and "singular" in err, err
+
+
+# ------------------------------------------------------------------------------ the memory budget
+
+def _npz_declaring(path, shape):
+    """An NPZ whose members' headers declare ``shape`` (float64) but hold no data."""
+    import io
+    import zipfile
+
+    with zipfile.ZipFile(path, "w") as z:
+        for name in ("u", "y"):
+            b = io.BytesIO()
+            np.lib.format.write_array_header_2_0(b, {"descr": "<f8", "fortran_order": False, "shape": shape})
+            z.writestr(name + ".npy", b.getvalue())
+    return path
+
+
+def test_an_npz_declaring_terabytes_is_refused_before_any_allocation(tmp_path):
+    p = _npz_declaring(tmp_path / "huge.npz", (1_000_000, 1_000_000))
+    with pytest.raises(FileError, match=r"the NPZ file declares 16 TB of samples \('[uy]': 1000000000000 "
+                                        r"values\), more than lptv's memory budget"):
+        lptv.read_measurements(p)
+    r = subprocess.run(LPTV + ["identify", str(p), "--na", "1", "--nb", "0"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 2 and "memory budget" in r.stderr and r.stderr.count("\n") == 1, r.stderr
+
+
+def test_a_mat73_dataset_declaring_terabytes_is_refused(tmp_path):
+    h5py = pytest.importorskip("h5py")
+    p = tmp_path / "huge.mat"
+    with h5py.File(p, "w", userblock_size=512) as f:
+        for name in ("u", "y"):
+            f.create_dataset(name, shape=(1_000_000, 1_000_000), dtype="f8", chunks=(1, 1000))
+    with open(p, "r+b") as f:
+        f.write(b"MATLAB 7.3 MAT-file".ljust(128))
+    with pytest.raises(FileError, match=r"the MATLAB v7.3 file declares 16 TB of samples"):
+        lptv.read_measurements(p)
+
+
+def test_the_budget_is_a_setting_and_files_within_it_read(tmp_path, monkeypatch):
+    p = tmp_path / "r.npz"
+    np.savez(p, u=np.ones((4, 256)), y=np.ones((4, 256)), w0=1.0)       # 16 kB as float64
+    monkeypatch.setenv("LPTV_MEMORY_BUDGET", "10K")
+    with pytest.raises(FileError, match=r"declares 16.4 kB of samples .* budget of 10.2 kB"):
+        lptv.read_measurements(p)
+    monkeypatch.setenv("LPTV_MEMORY_BUDGET", "1M")
+    assert lptv.read_measurements(p).u.shape == (4, 256)
+    monkeypatch.setenv("LPTV_MEMORY_BUDGET", "lots")
+    with pytest.raises(FileError, match="LPTV_MEMORY_BUDGET must be a number of bytes"):
+        lptv.read_measurements(p)
+
+
+# ------------------------------------------------------------------------------ drift and transient
+
+def _filtered_record(P=6, N=256, seed=0, transient=False):
+    """A periodic random-phase input (NumPy) through a second-order filter (scipy.signal), in
+    steady state or from rest, with 1 % noise: made outside lptv."""
+    from scipy import signal
+
+    rng = np.random.default_rng(seed)
+    X = np.zeros(N // 2 + 1, complex)
+    X[1:40] = np.exp(2j * np.pi * rng.random(39))
+    u1 = np.fft.irfft(X, N) * N / np.sqrt(39)
+    b, a = signal.butter(2, 0.15)
+    u = np.tile(u1, P + (0 if transient else 4))
+    y = signal.lfilter(b, a, u)
+    if not transient:
+        u, y = u[4 * N:], y[4 * N:]
+    u = u.reshape(P, N) + 0.01 * rng.standard_normal((P, N))
+    y = y.reshape(P, N) + 0.01 * np.std(y) * rng.standard_normal((P, N))
+    return u, y
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_linear_drift_is_called_a_drift_and_detrend_removes_it(tmp_path, seed):
+    u, y = _filtered_record(seed=seed)
+    P, N = y.shape
+    drift = 0.05 * np.std(y) * (np.arange(P * N) / N).reshape(P, N)       # 5 % of y's std per period
+    c = lptv.check_record(u, y + drift, warn=False)
+    assert any("output drifts" in m and "--detrend" in m for m in c.messages), c.messages
+    assert not any(m.startswith("the first period differs") for m in c.messages), c.messages
+    assert not any("input drifts" in m for m in c.messages), c.messages
+    np.savez(tmp_path / "d.npz", u=u, y=y + drift, w0=1.0)
+    m = lptv.read_measurements(tmp_path / "d.npz", detrend=True)
+    assert lptv.check_record(m.u, m.y, warn=False).ok
+    # the trend is gone and the periods' shape kept: within the noise of the record without drift
+    np.testing.assert_allclose(m.y - m.y.mean(), y - y.mean(), atol=6 * 0.01 * np.std(y))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_start_up_transient_is_still_a_transient_and_no_drift(seed):
+    u, y = _filtered_record(seed=seed, transient=True)
+    c = lptv.check_record(u, y, warn=False)
+    assert any("start-up transient" in m for m in c.messages), c.messages
+    assert not any("drifts" in m for m in c.messages), c.messages
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_steady_record_is_neither(seed):
+    u, y = _filtered_record(seed=seed)
+    assert lptv.check_record(u, y, warn=False).ok
