@@ -7,7 +7,7 @@ and prints how many gave each outcome: clear error, warning with a meaningful re
 result, unclear error, silent wrong result, crash; then the counts per class of bad value, and
 every case whose outcome is not the expected one.
 
-    PYTHONPATH=python python bench/python/bad_inputs.py [--fork]
+    PYTHONPATH=python python bench/python/bad_inputs.py [--fork] [--limit N]
 
 ``--fork`` runs the command-line cases as the test suite does (forked from one process that has
 imported lptv), which is faster on a loaded machine.
@@ -33,13 +33,18 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--fork", action="store_true", help="fork the command-line cases (as the tests do)")
     ap.add_argument("--python", metavar="DIR", help="the lptv package to test (default: this tree's python/)")
+    ap.add_argument("--limit", type=int, metavar="N", help="the first N cases of each kind only (a quick run)")
     args = ap.parse_args(argv)
     if args.python:
         table.PYTHONPATH = str(Path(args.python).resolve())
 
     t0 = time.perf_counter()
     py, cli = table.python_cases(), table.cli_cases()
-    out = runner.run_all(workers=2, fork=args.fork)
+    if args.limit is None:
+        out = runner.run_all(workers=2, fork=args.fork)
+    else:
+        py, cli = py[:args.limit], cli[:args.limit]
+        out = {**runner.run_python_cases([c.id for c in py]), **runner.run_cli_cases(cli, 2, fork=args.fork)}
     elapsed = time.perf_counter() - t0
 
     cases = py + cli
@@ -65,6 +70,10 @@ def main(argv=None) -> int:
     print(f"cases whose outcome is not the expected one: {len(wrong)}")
     for c in wrong:
         print(f"  {c.id}: {out[c.id][0]} (expected {c.expected}): {out[c.id][1][:200]}")
+    if wrong:
+        c = wrong[0]
+        print(f"bad_inputs: {len(wrong)} of {len(cases)} cases with another outcome than the expected one; the first, "
+              f"{c.id}: {out[c.id][0]} (expected {c.expected}): {out[c.id][1][-200:]}", file=sys.stderr)
     return 1 if wrong else 0
 
 

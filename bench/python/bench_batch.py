@@ -220,7 +220,7 @@ def main():
         t0 = time.perf_counter()
         out = run_tasks(noop, range(n_noop), design, executor=ex, chunk_size=1, progress=False, **kw)
         dt = (time.perf_counter() - t0) / n_noop
-        assert out == list(range(n_noop))
+        assert out == list(range(n_noop)), f"{name}: the empty tasks returned {out[:5]}... instead of 0..{n_noop - 1}"
         over[name] = dt
         print(f"{name:34s} {1e6 * dt:8.1f} {1 / dt:8.0f} {1e6 * dt / 32:19.1f} {100 * dt / 32 / t_fit:9.2f}%",
               flush=True)

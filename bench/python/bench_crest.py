@@ -2,7 +2,7 @@
 and the time the design takes (the compiled core against the SciPy reference on the same objective).
 
     python bench/python/bench_crest.py table            # crest factors, one design per case
-    python bench/python/bench_crest.py timing 50        # core and reference alternated, 5 pairs
+    python bench/python/bench_crest.py timing 50 [5]    # core and reference alternated, 5 pairs
 
 The table: flat spectra of F consecutive lines (1..F) and odd-odd designs (every 4th line),
 N = 16 F rounded up to a power of two, the peak taken on 16 points per period of the top line;
@@ -62,8 +62,9 @@ def main():
     lines, N = case(F, "flat")
     if mode == "timing":
         # the same design in turn by the core and by the reference, in one process, 5 pairs
+        pairs = int(sys.argv[3]) if len(sys.argv) > 3 else 5
         tc, tr = [], []
-        for _ in range(5):
+        for _ in range(pairs):
             t = time.perf_counter()
             ms = lptv.min_crest_multisine(lines, N)
             tc.append(time.perf_counter() - t)

@@ -5,12 +5,14 @@ on spectra built beforehand), ``lptv.identify`` (WGTLS from the periods, as a us
 and ``_core.estimate`` (SML). Seed 1 of ``lptv.examples.paper_measurements`` (P = 8), lines
 1..243, tol 1e-12. With ``--lti``: the 4th-order LTI case of bench_ml_lti.py (500 lines, P = 8),
 ``_core.estimate`` (SML) and ``lptv.identify`` on its spectra (SML), as that bench calls them.
+``--rounds R --calls N`` change the 7 rounds of 40 calls.
 To compare two builds, append each one's lines to a file of its own:
 
     OPENBLAS_NUM_THREADS=1 farm-bench -n 5 \\
         --vs "sh -c 'exec OLD/.venv/bin/python bench/python/bench_fit_times.py >> /tmp/B.txt 2>&1'" \\
         -- sh -c 'PYTHONPATH=python exec .venv/bin/python bench/python/bench_fit_times.py >> /tmp/A.txt 2>&1'
 """
+import argparse
 import os
 import sys
 import time
@@ -36,8 +38,15 @@ def lti_routes():
     }
 
 
-def main():
-    if "--lti" in sys.argv[1:]:
+def main(argv=None):
+    global ROUNDS, CALLS
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--lti", action="store_true", help="the LTI case of bench_ml_lti.py")
+    ap.add_argument("--rounds", type=int, default=ROUNDS)
+    ap.add_argument("--calls", type=int, default=CALLS, help="calls per round")
+    args = ap.parse_args(argv)
+    ROUNDS, CALLS = args.rounds, args.calls
+    if args.lti:
         report(lti_routes())
         return
     m = paper_measurements(1, periods=8)

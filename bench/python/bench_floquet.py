@@ -1,6 +1,6 @@
 """lptv.floquet on the paper's example, and the independent product route beside it.
 
-    python bench/python/bench_floquet.py
+    python bench/python/bench_floquet.py [--rounds R] [--inner N]   (default 7 rounds of 5 calls)
 
 - ``lptv.floquet(paper_model())``: Hill's method in the core (harmonics of F(t) from 1/a_2(t),
   the truncation grown until the exponents settle), as a user calls it;
@@ -12,6 +12,7 @@ The routes take turns over rounds; each one's fastest round counts (machines are
 multipliers must agree to 1e-9 of ||Phi|| (asserted): Hill's own error bound on the paper's
 example is 2.8e-9 relative to its multipliers, measured agreement 1.3e-10.
 """
+import argparse
 import os
 import time
 
@@ -35,7 +36,11 @@ def fastest(fns, rounds=7, inner=5):
     return best
 
 
-def main():
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument("--inner", type=int, default=5, help="calls per round")
+    args = ap.parse_args(argv)
     print(f"load average at start: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores")
     for name, model in [("paper example (na=2, 3 harmonics on a_0..a_2, w0=0.04)", paper_model()),
                         ("damped Mathieu (zeta=0.02, eps=0.1, w0=2 wn)", mathieu_model())]:
@@ -44,18 +49,18 @@ def main():
         mu = np.linalg.eigvals(P)
         diff = min(np.max(np.abs(f.multipliers - mu[list(p)])) for p in ([0, 1], [1, 0]))
         rel = diff / np.linalg.norm(P, 2)
-        assert rel <= AGREE, (name, rel)
+        assert rel <= AGREE, f"{name}: Hill's and the product's multipliers differ by {rel:.1e} of ||Phi|| ({AGREE:g} at most expected)"
         t = fastest({
             "floquet (Hill)": lambda: lptv.floquet(model),
             "monodromy + eig": lambda: np.linalg.eigvals(monodromy(model, 2000)),
-        })
+        }, args.rounds, args.inner)
         print(name)
         print(f"  multipliers {np.array2string(f.multipliers, precision=4)}, stable {f.is_stable}")
         print(f"  Hill: truncation M = {f.truncation} (matrix {model.na * (2 * f.truncation + 1)}), "
               f"harmonics of F {f.harmonics}, error estimate {f.error_estimate.max():.1e}, "
               f"|mu_Hill - mu_product| / ||Phi|| = {rel:.1e}")
         for k, v in t.items():
-            print(f"  {k:16s} {1e3 * v:8.2f} ms  (fastest of 7 rounds of 5 calls)")
+            print(f"  {k:16s} {1e3 * v:8.2f} ms  (fastest of {args.rounds} rounds of {args.inner} calls)")
 
 
 if __name__ == "__main__":

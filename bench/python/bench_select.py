@@ -1,6 +1,8 @@
 """Structure selection (lptv.select) on a 3 x 3 x 4 grid, serial and on 2 processes; htf_estimate.
 
-    python bench/python/bench_select.py [rounds]   (default 3)
+    python bench/python/bench_select.py [rounds] [--small]   (default 3)
+
+``--small``: the grid na = 2, nb = 1, k = 3..4 and 20 / 200 calls of htf_estimate (a quick run).
 
 1. The paper example (lptv.examples.paper_measurements, seed 1, P = 8), the grid na = 1..3,
    nb = 0..2, k = 1..4 (36 structures, WGTLS; then SML on the best 2 per k: 8 more fits), MDL,
@@ -27,10 +29,11 @@ def load():
     return " ".join(open("/proc/loadavg").read().split()[:3])
 
 
-def main(rounds=3):
+def main(rounds=3, small=False):
     m = paper_measurements(seed=1, periods=8)
-    grid = dict(na=range(1, 4), nb=range(0, 3), k=range(1, 5))
-    print(f"lptv.select on the paper example (seed 1, P = 8), grid na 1..3 x nb 0..2 x k 1..4, MDL; "
+    grid = dict(na=range(2, 3), nb=range(1, 2), k=range(3, 5)) if small else dict(na=range(1, 4), nb=range(0, 3), k=range(1, 5))
+    print(f"lptv.select on the paper example (seed 1, P = 8), grid na {grid['na'][0]}..{grid['na'][-1]} x nb "
+          f"{grid['nb'][0]}..{grid['nb'][-1]} x k {grid['k'][0]}..{grid['k'][-1]}, MDL; "
           f"load at start {load()}")
     for label, lines in (("default rows (largest k: 5..1019)", None), ("lines 1..243", range(1, 244))):
         best, ref = {}, None
@@ -42,15 +45,17 @@ def main(rounds=3):
                 dt = time.perf_counter() - t
                 best[name] = min(best.get(name, np.inf), dt)
                 ref = ref or sel
-                assert sel.rows == ref.rows and sel.choice == (2, 1, 3)
+                assert sel.rows == ref.rows, f"{name}: the ranking differs from the first run's"
+                assert sel.choice == (2, 1, 3), f"{name}: chose {sel.choice}, not the true (2, 1, 3)"
                 print(f"  {label}, round {r + 1}: {name:12s} {dt:6.2f} s (load {load()})")
         n_sml = sum(r["method"] == "sml" for r in ref.rows)
         print(f"{label}: {len(ref.rows)} WGTLS + {n_sml} SML fits; serial {best['serial']:.2f} s, "
               f"2 processes {best['2 processes']:.2f} s ({best['serial'] / best['2 processes']:.2f}x); "
               f"choice {ref.choice}, identical rankings")
     d = lptv.FrequencyData.from_periods(m["u"], m["y"], w0=m["w0"])
-    for label, call, n in (("from the periods (8 x 2048)", lambda: lptv.htf_estimate(m["u"], m["y"], w0=m["w0"], branches=4), 200),
-                           ("from a FrequencyData", lambda: lptv.htf_estimate(d, branches=4), 2000)):
+    calls = (20, 200) if small else (200, 2000)
+    for label, call, n in (("from the periods (8 x 2048)", lambda: lptv.htf_estimate(m["u"], m["y"], w0=m["w0"], branches=4), calls[0]),
+                           ("from a FrequencyData", lambda: lptv.htf_estimate(d, branches=4), calls[1])):
         ts = []
         for _ in range(n):
             t = time.perf_counter()
@@ -62,4 +67,5 @@ def main(rounds=3):
 
 
 if __name__ == "__main__":
-    main(*(int(a) for a in sys.argv[1:2]))
+    args = sys.argv[1:]
+    main(*[int(a) for a in args if a != "--small"][:1], small="--small" in args)

@@ -20,7 +20,7 @@ BUDGET_S. The routes must agree to 1e-10 of the output peak (asserted): all solv
 linear system, A is diagonally dominant (harmonics below 40 % of the DC coefficient in every
 row), so their difference is rounding.
 
-Usage: python bench_simulate.py [max_lines]   (default 10^6)
+Usage: python bench_simulate.py [max_lines] [first_L]   (default 10^6 1000: L = 1000, 10^4, ... up to max_lines)
 """
 from __future__ import annotations
 
@@ -116,7 +116,7 @@ def timed(calls, reps):
     return t, out
 
 
-def main(max_lines: int = 10**6):
+def main(max_lines: int = 10**6, first: int = 1000):
     model = ex.paper_model()
     rng = np.random.default_rng(0)
     solver = lptv.simulate(model, np.ones(3), full_output=True).solver
@@ -139,7 +139,7 @@ def main(max_lines: int = 10**6):
         f" {'sim/band':>9} {'sim/g/band':>10} {'klu/band':>9} {'klu/g/band':>10} {'sim/pre':>8}" \
         f" {'max diff':>9}"
     print(head)
-    L = 1000
+    L = first
     skipped = []
     while L <= max_lines:
         U = np.exp(2j * np.pi * rng.uniform(size=L + 1)) / np.sqrt(L)
@@ -194,4 +194,4 @@ def main(max_lines: int = 10**6):
 
 
 if __name__ == "__main__":
-    main(int(float(sys.argv[1])) if len(sys.argv) > 1 else 10**6)
+    main(*(int(float(a)) for a in sys.argv[1:3]))

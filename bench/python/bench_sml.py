@@ -1,6 +1,6 @@
 """SML on the exact likelihood against WGTLS, side by side, and SML on a 4th-order LTI case.
 
-    python bench/python/bench_sml.py
+    python bench/python/bench_sml.py [--rounds R] [--inner N]   (default 7 rounds of 5 calls)
 
 - the paper's example (lines 1..243, 34 free parameters, P = 8): ``lptv._core.estimate`` with
   method 'wgtls' and 'sml' (the compiled estimators alone, data built beforehand), and
@@ -9,6 +9,7 @@
   (na = 4, nb = 0), 500 excited lines, P = 8, SNR 40 dB in and out: the SML estimate alone.
 The routes take turns over rounds; each one's fastest round counts (machines are shared).
 """
+import argparse
 import time
 import warnings
 
@@ -30,7 +31,11 @@ def fastest(fns, rounds=7, inner=5):
     return best
 
 
-def main():
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument("--inner", type=int, default=5, help="calls per round")
+    args = ap.parse_args(argv)
     warnings.simplefilter("ignore")
     m = paper_measurements(seed=1, periods=8)
     data = lptv.FrequencyData.from_periods(m["u"], m["y"], w0=m["w0"])
@@ -42,8 +47,8 @@ def main():
         "core sml": lambda: _core.estimate(data._cpp, par, rows, method="sml"),
         "identify wgtls": lambda: lptv.identify(data, method="wgtls", **kw),
         "identify sml": lambda: lptv.identify(data, method="sml", **kw),
-    })
-    print("paper example, P = 8, 34 free parameters on 243 lines (fastest of 7 rounds of 5 calls)")
+    }, args.rounds, args.inner)
+    print(f"paper example, P = 8, 34 free parameters on 243 lines (fastest of {args.rounds} rounds of {args.inner} calls)")
     for k, v in t.items():
         print(f"  {k:15s} {1e3 * v:7.2f} ms")
     print(f"  sml / wgtls: core {t['core sml'] / t['core wgtls']:.2f}x, identify "
@@ -63,7 +68,7 @@ def main():
         "core wgtls": lambda: _core.estimate(d._cpp, p4, r4, method="wgtls"),
         "core sml": lambda: _core.estimate(d._cpp, p4, r4, method="sml"),
         "identify sml": lambda: lptv.identify(d, na=4, nb=0, lines=r4, method="sml"),
-    })
+    }, args.rounds, args.inner)
     est = _core.estimate(d._cpp, p4, r4, method="sml")
     print("LTI, na = 4, nb = 0, 500 lines, P = 8 (5 free parameters)")
     for k, v in t.items():

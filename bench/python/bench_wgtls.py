@@ -28,7 +28,7 @@ threads that spin for a while after a call; on a machine with few cores the two 
 slow the reference down. ``make bench`` runs this script twice, as is and with
 OPENBLAS_NUM_THREADS=1 (the reference's faster setting here).
 
-Usage: python bench_wgtls.py [seeds]   (default 3: seeds 1..3)
+Usage: python bench_wgtls.py [seeds] [rounds]   (default 3 7: seeds 1..3, 7 rounds)
        python bench_wgtls.py --phases   (where lptv.identify's time goes, seed 1: its parts
        wrapped with timers, mean of 200 calls after 20)
 """
@@ -88,13 +88,13 @@ def routes(u, y, w0):
             "ref est": ref_est}
 
 
-def main(n_seeds: int = 3):
+def main(n_seeds: int = 3, rounds: int = ROUNDS):
     print("WGTLS, C++ core vs NumPy reference (lptv.reference.identification), paper-like example")
     print(f"data: lptv.examples.paper_measurements(seed, periods=8); na={NA}, nb={NB}, ka=kb={K} "
           f"(35 parameters), lines {LINES.start}..{LINES.stop - 1}, tol={TOL:g}")
     print(f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', '(unset: one thread per core)')}"
           " - NumPy's BLAS threads (the core's own BLAS runs single-threaded at this size)")
-    print(f"times: the fastest of {ROUNDS} interleaved rounds, calls timed whole; "
+    print(f"times: the fastest of {rounds} interleaved rounds, calls timed whole; "
           "reference/identify (goal: >= 25x) and ref est/core (goal: >= 20x) are the ratios\n")
     print(f"{'seed':>4} {'iter':>5} {'identify':>10} {'id none':>10} {'core':>10} {'reference':>10} {'ref est':>10} "
           f"{'ref/identify':>12} {'ref est/core':>12} {'identify/core':>13} {'none/core':>9} {'theta diff':>10}")
@@ -108,7 +108,7 @@ def main(n_seeds: int = 3):
         assert diff <= AGREE, f"seed {seed}: the estimates differ by {diff:.1e}"
         its = f"{results['core'][1]}/{results['ref est'][1]}"
         best = {name: np.inf for name in fns}
-        for _ in range(ROUNDS):
+        for _ in range(rounds):
             for name, f in fns.items():
                 t0 = time.perf_counter()
                 f()
@@ -184,4 +184,4 @@ if __name__ == "__main__":
     if len(sys.argv) > 1 and sys.argv[1] == "--phases":
         phases()
     else:
-        main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
+        main(*(int(a) for a in sys.argv[1:3]))

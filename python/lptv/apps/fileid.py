@@ -207,6 +207,9 @@ def add_parser(sub):
                    help="with --fs: drop the first samples of a long record to keep whole periods")
     p.add_argument("--skip-periods", type=int, default=0, metavar="K",
                    help="drop the first K periods (a start-up transient)")
+    p.add_argument("--detrend", action="store_true",
+                   help="take a linear drift out of each channel (the trend across the periods; each "
+                   "period's shape is kept)")
     p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150, or 'excited' (the lines "
                    "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
                    "judges every row that reads a line with signal")
@@ -568,12 +571,13 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
 
 def read_options(args) -> dict:
     """The keyword arguments of lptv.read_measurements the options give (--periods, --fs / --dt,
-    --period or --w0, --trim, --skip-periods, --input, --output, --time)."""
+    --period or --w0, --trim, --skip-periods, --input, --output, --time, --detrend)."""
     period = positive(args.period, "--period")
     if period is None and positive(args.w0, "--w0") is not None:
         period = 2 * np.pi / args.w0
     return dict(periods=args.periods, fs=args.fs, dt=args.dt, period=period, trim=args.trim,
-                skip_periods=args.skip_periods, u=args.input, y=args.output, time=args.time)
+                skip_periods=args.skip_periods, u=args.input, y=args.output, time=args.time,
+                detrend=getattr(args, "detrend", False))
 
 
 def read_record(src, args, realisations: bool = False):

@@ -3,11 +3,13 @@
 The options are those of ``lptv identify FILE`` (:mod:`lptv.apps.fileid`), the same for every
 file. The fits run on local processes (``--workers``, default all cores; 1 runs them here) or on
 a Dask cluster (``--scheduler``: the files are read by the workers, so their paths must exist
-there). Writes ``results.csv`` (one row per file: the verdict, the parameters and their std,
+there). Writes ``results.csv`` (one row per file: the verdict (``model_ok``), the parameters and their std,
 or the error message), ``models/<name>.json`` for each file that was fitted (the file's stem, with a hash of its
 path when two files of the batch share the stem) and ``summary.json`` (which also maps each file
-to its model); prints one line per file. Exit status 0 when every file was fitted, 1 when
-some failed (their rows say why), 2 for bad options.
+to its model); prints one line per file. Exit status 0 when every file was fitted and
+every model is consistent with its data, 3 when every file was fitted but the verdict finds model
+errors in some (their rows' ``model_ok`` is False), 1 when some failed (their rows say why), 2 for
+bad options.
 
 Example::
 
@@ -29,6 +31,11 @@ from lptv.batch.executors import LOST
 from lptv.batch.parts import CheckpointError, clear, stored_items
 from lptv.apps.report import write_json
 from lptv.measurements import FileError
+
+
+MODEL_ERRORS = 3
+"""The exit status when every file was fitted but the verdict finds model errors in some (as
+lptv identify FILE's)."""
 
 
 def _error(problem) -> int:
@@ -167,7 +174,8 @@ def _write(args, out, parts, result) -> int:
           f"{result.elapsed:.1f} s -> {out}/")
     for row in result.rows:
         if row["ok"]:
-            verdict = "residue consistent with the noise" if row["residue_ok"] else "residue OUTSIDE the band"
+            verdict = ("model consistent with the data" if row["model_ok"] else "MODEL ERRORS") + (
+                "" if row["residue_ok"] else ", residue OUTSIDE the band")
             conv = "" if row["converged"] else ", NOT converged"
             print(f"  ok      {row['record']}: {row['periods']} x {row['samples']}, {verdict}{conv}")
         else:
@@ -184,10 +192,13 @@ def _write(args, out, parts, result) -> int:
             "files": len(result.rows), "fitted": len(result.rows) - result.n_failed,
             "failed": result.n_failed, "not_converged": sum(1 for r in result.rows if r["ok"] and not r["converged"]),
             "residue_outside_band": sum(1 for r in result.rows if r["ok"] and not r["residue_ok"]),
+            "model_errors": sum(1 for r in result.rows if r["ok"] and not r["model_ok"]),
             "method": args.method, "executor": result.executor, "seconds": result.elapsed,
             "failures": [{"file": f, "error": e} for f, e in result.failures], "models": models})
     except OSError as e:
         return _error(f"{e.filename or out}: {e.strerror or e}")
-    print(f"{len(result.rows) - result.n_failed} of {len(result.rows)} files fitted; wrote "
+    rejected = sum(1 for r in result.rows if r["ok"] and not r["model_ok"])
+    print(f"{len(result.rows) - result.n_failed} of {len(result.rows)} files fitted"
+          + (f", {rejected} with model errors (column model_ok)" if rejected else "") + "; wrote "
           f"{out / 'results.csv'}, {out / 'models'}/, {out / 'summary.json'}")
-    return 1 if result.n_failed else 0
+    return 1 if result.n_failed else (MODEL_ERRORS if rejected else 0)

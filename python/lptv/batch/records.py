@@ -21,7 +21,7 @@ from .executors import Failure, describe_executor, require, run_tasks
 
 # The columns every row has, before the parameters (eta and eta.std by name).
 COLUMNS = ("record", "ok", "error", "format", "periods", "samples", "w0", "method", "converged",
-           "iterations", "cost", "fraction_above_0db", "fraction_expected", "residue_ok",
+           "iterations", "cost", "fraction_above_0db", "fraction_expected", "residue_ok", "model_ok",
            "n_free_parameters", "warnings")
 
 
@@ -98,6 +98,7 @@ def identify_record(item, settings) -> dict:
         w0=w0, method=res.method, converged=bool(res.converged), iterations=int(res.iterations),
         cost=float(res.cost), fraction_above_0db=float(res.fraction_above_0db),
         fraction_expected=float(res.fraction_expected), residue_ok=bool(res.residue_ok),
+        model_ok=bool(res.model_ok),
         n_free_parameters=int(res.n_free_parameters), warnings="; ".join(tuple(res.warnings) + extra),
         eta_names=tuple(res.eta_names), eta=res.eta, std=std, model=res.model.to_dict())
 
