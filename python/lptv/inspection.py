@@ -20,7 +20,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ._validate import as_float, as_int, as_path
+from ._validate import _array, as_float, as_int, as_path
 from .channels import FileError
 
 __all__ = ["Inspection", "LineClass", "inspect"]
@@ -491,12 +491,12 @@ def _off_grid_lines(y, N, m):
     if P < 2:
         return False
     lines, Y, var = _spectra(y[y.size - P * N:].reshape(P, N))
-    noise, w = _pooled(var, P)
+    noise, nu = _pooled(var, P)
     off = lines % m != 0
     p2 = np.abs(Y) ** 2
     with np.errstate(divide="ignore", invalid="ignore"):
         z = np.where(p2 > 1e-20 * p2.max(), p2 / (noise / P), 0.0)[off]
-    return bool(np.any(z > _threshold(int(off.sum()), w, P)))
+    return bool(np.any(z > _threshold(int(off.sum()), nu)))
 
 
 # ------------------------------------------------------------------------------ the periods
@@ -527,21 +527,33 @@ def _spectra(xs):
 
 
 def _pooled(var, P):
-    """The per-line noise variance pooled over neighbouring lines: their median, unbiased for a
-    variance from P periods (complex Gaussian noise: var ~ sigma^2 Gamma(P - 1, 1 / (P - 1)))."""
+    """(noise, nu): the per-line noise variance pooled over w neighbouring lines (their median,
+    unbiased for a variance from P periods of complex Gaussian noise, var ~ sigma^2 Gamma(P - 1,
+    1 / (P - 1))); the windows at the ends of the band are the first and last w lines. nu: the
+    degrees of freedom of a scaled chi-square with the median's variance, 1 / (4 w f(m)^2)
+    relative to m^2 (f the density at the median m)."""
     from scipy.ndimage import median_filter
     from scipy.stats import gamma
 
-    w = min(2 * NOISE_HALF_WINDOW + 1, var.size)
+    n = var.size
+    w = min(2 * NOISE_HALF_WINDOW + 1, n)
+    h = w // 2
     med = median_filter(var, size=w, mode="nearest")
-    return med / (gamma.ppf(0.5, P - 1) / (P - 1)), w
+    if n > w:
+        med[:h] = np.median(var[:w])
+        med[n - h:] = np.median(var[n - w:])
+    else:
+        med[:] = np.median(var)
+    law = gamma(P - 1, scale=1.0 / (P - 1))
+    m = law.median()
+    nu = 4.0 * w * (m * law.pdf(m)) ** 2
+    return med / m, nu
 
 
-def _threshold(n_lines, w, P):
+def _threshold(n_lines, nu):
     """The line test's threshold t on |X|^2 / (sigma^2 / P): noise alone exceeds it on any of
-    n_lines lines with chance ALPHA, sigma^2 being a median of w lines' variances from P
-    periods (about 0.64 w (P - 1) complex degrees of freedom: F(2, 2 nu))."""
-    nu = max(0.64 * w * (P - 1), 1.0)
+    n_lines lines with chance ALPHA, sigma^2 being estimated with nu degrees of freedom
+    (|X|^2 over it is then F(2, 2 nu): P(F > t) = (1 + t / nu)^-nu)."""
     return float(nu * ((max(n_lines, 1) / ALPHA) ** (1.0 / nu) - 1.0))
 
 
@@ -680,9 +692,15 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         uu, yy, names, fmt, found, stored, kind = _raw_record(p, u, y, time, fs_in is not None)
         source, what = str(path), f"{kind} '{names[0]}'"
     else:
-        if u is None or y is None:
-            raise ValueError("give a file (path) or the samples u and y")
-        uu, yy = (np.asarray(v, dtype=float) for v in (u, y))
+        for name, v in (("u", u), ("y", y)):
+            if v is None:
+                raise ValueError(f"{name} is missing: give a file (path), or the samples u and y")
+        uu, yy = (_array(v, name) for v, name in ((u, "u"), (y, "y")))
+        for name, v in (("u", uu), ("y", yy)):
+            if v.dtype.kind == "c" or v.ndim > 2:
+                raise ValueError(f"{name} must be a real record (1-D, or periods x samples), got "
+                                 f"{'complex values' if v.dtype.kind == 'c' else f'shape {v.shape}'}")
+        uu, yy = uu.astype(float), yy.astype(float)
         stored = uu.shape[1] if uu.ndim == 2 and min(uu.shape) > 1 else None
         uu, yy = uu.ravel(), yy.ravel()
         if uu.size != yy.size:
@@ -691,7 +709,7 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
     for name, v in zip(names, (uu, yy)):
         bad = np.flatnonzero(~np.isfinite(v))
         if bad.size:
-            raise FileError(f"'{name}' is NaN or inf at sample {bad[0] + 1}")
+            raise FileError(f"{name} contains NaN or inf (sample {bad[0] + 1})")
     if uu.size < 8:
         raise FileError(f"the record holds {uu.size} samples: too few to look for a period")
     if np.ptp(uu) == 0:
@@ -747,9 +765,9 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
     Ps = P - skip
     lines, U, varU = _spectra(us[skip:])
     _, Y, varY = _spectra(ys[skip:])
-    nu, w = _pooled(varU, Ps)
+    nu, dof = _pooled(varU, Ps)
     ny, _ = _pooled(varY, Ps)
-    t = _threshold(lines.size, w, Ps)
+    t = _threshold(lines.size, dof)
     with np.errstate(divide="ignore", invalid="ignore"):
         zu = np.where(nu > 0, np.abs(U) ** 2 / (nu / Ps), np.where(np.abs(U) > 0, np.inf, 0.0))
         zy = np.where(ny > 0, np.abs(Y) ** 2 / (ny / Ps), np.where(np.abs(Y) > 0, np.inf, 0.0))

@@ -131,6 +131,16 @@ def write(name, content):
     return path
 
 
+@functools.lru_cache(None)
+def ins_record():
+    """12 periods of 50 samples of cosines on lines 2, 5 and 7, and a filtered copy, with noise."""
+    k = np.arange(600)
+    rng = np.random.default_rng(0)
+    u = sum(np.cos(2 * np.pi * l * k / 50 + l) for l in (2, 5, 7)) + 1e-3 * rng.standard_normal(600)
+    y = np.convolve(u, [0.5, 0.5])[:600] + 1e-3 * rng.standard_normal(600)
+    return u, y
+
+
 def good_npz():
     u, y = periods()
     return write("good.npz", {"u": u, "y": y, "w0": 0.1})
@@ -352,6 +362,35 @@ def python_cases():
              match=with_value("max_count", 2**63)),
         Case("disturbances-short-record", "value", lambda: lp().disturbances(*dist_uy(2, 8)),
              check=lambda out: out.found == ()),
+    ]
+    # what a record holds before any model (lptv.inspect)
+    C += family("inspect", "fs", lambda v: lp().inspect(u=ins_record()[0], y=ins_record()[1], fs=v), FLOAT_BAD,
+                skip=("none",))
+    C += family("inspect", "dt", lambda v: lp().inspect(u=ins_record()[0], y=ins_record()[1], dt=v), FLOAT_BAD,
+                skip=("none",))
+    C += family("inspect", "reach", lambda v: lp().inspect(u=ins_record()[0], y=ins_record()[1], reach=v), INT_BAD,
+                skip=("none",))
+    C += [
+        Case("inspect-y-missing", "type", lambda: lp().inspect(u=ins_record()[0]), match=names("y")),
+        Case("inspect-u-str", "type", lambda: lp().inspect(u="abc", y=ins_record()[1]), match=names("u")),
+        Case("inspect-u-complex", "type", lambda: lp().inspect(u=ins_record()[0] * 1j, y=ins_record()[1]),
+             match=names("u")),
+        Case("inspect-u-nan", "nan/inf", lambda: lp().inspect(u=np.where(np.arange(600) == 5, NaN, ins_record()[0]),
+                                                              y=ins_record()[1]), match=names("u")),
+        Case("inspect-y-length", "shape", lambda: lp().inspect(u=ins_record()[0], y=ins_record()[1][:-1]),
+             match=names("y")),
+        Case("inspect-short", "size", lambda: lp().inspect(u=np.ones(4), y=np.ones(4)), match="too few"),
+        Case("inspect-dead-input", "value", lambda: lp().inspect(u=np.ones(600), y=ins_record()[1]),
+             match="dead or disconnected input"),
+        Case("inspect-fs-and-dt", "value", lambda: lp().inspect(u=ins_record()[0], y=ins_record()[1], fs=1.0, dt=1.0),
+             match="not both"),
+        Case("inspect-file-missing", "file", lambda: lp().inspect(folder() / "none.csv"), match="no such file"),
+        Case("inspect-file-junk", "file", lambda: lp().inspect(write("junk.csv", JUNK)), match="text"),
+        Case("inspect-file-input-missing", "file", lambda: lp().inspect(good_npz(), u="force"),
+             match=r"'force', the input named by --input \(u=\), is missing"),
+        Case("inspect-value", "value", lambda: lp().inspect(u=ins_record()[0], y=ins_record()[1], fs=10.0),
+             check=lambda r: r.period_samples == 50 and r.period == 5.0 and r.lines.tolist() == [2, 5, 7]),
+        Case("plots.inspection-insp-str", "type", lambda: _plots().inspection("abc"), match=names("insp")),
     ]
     # one record with its transient
     def rec():
@@ -987,6 +1026,20 @@ def cli_cases():
     add("identify-resume-one-file", ok + ("--resume",), "--resume")
     add("identify-resume-nothing", ok + ("--workers", "1", "--out", "{dir}/batch", "--resume"), "--resume")
     add("identify-na-missing", ("identify", "{dir}/good.npz", "--nb", "0"), "--na")
+    # lptv inspect
+    ins = ("inspect", "{dir}/good.npz", "--out", "{dir}/inspect")
+    for f in ("junk.csv", "junk.mat", "cut.npz", "dir.npz", "none.npz"):
+        add(f"inspect-file-{f}", ("inspect", "{dir}/" + f), f)
+    for opt in ("--fs", "--dt"):
+        for v in ("nan", "inf", "-1", "0", "abc"):
+            add(f"inspect-{opt[2:]}-{v}", ins + (opt, v), opt)
+    for v in ("0", "-1", "abc") + big:
+        add(f"inspect-reach-{v}", ins + ("--reach", v), "--reach")
+    add("inspect-input-missing", ins + ("--input", "force"), "--input")
+    add("inspect-output-missing", ins + ("--output", "disp"), "--output")
+    add("inspect-time-missing", ins + ("--time", "clock"), "--time")
+    add("inspect-out-proc", ins[:2] + ("--out", "/proc/nope"), "/proc/nope")
+    add("inspect-unknown-option", ins + ("--nope", "1"), "--nope")
     # lptv select
     add("select-file-junk", ("select", "{dir}/junk.csv", "--periods", "4"), "junk.csv")
     add("select-file-transposed", ("select", "{dir}/transposed.npz"), "transposed")

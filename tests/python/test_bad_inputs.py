@@ -53,7 +53,7 @@ NOT_CALLED_BY_USERS = {"NumericalError", "IdentifiabilityWarning", "TruncationWa
                        "ConditioningWarning", "UnstableModelWarning", "StabilityUndecidedWarning",
                        "METHODS", "CramerRaoBound", "FloquetResult", "SimulationResult", "RecordCheck",
                        "Measurements", "RecordResult", "ModeratedNoise", "Disturbance", "DisturbanceResult",
-                       "LackOfFit"}
+                       "LackOfFit", "Inspection", "LineClass"}
 
 
 @pytest.mark.parametrize("name", sorted(set(lptv.__all__) - NOT_CALLED_BY_USERS))
@@ -65,12 +65,13 @@ def test_every_public_name_has_bad_inputs(name):
 
 def _options():
     """{command: option strings} of the lptv command, from the parsers the command builds."""
-    from lptv.apps import choose, cli, fileid, montecarlo
+    from lptv.apps import choose, cli, fileid, inspectrec, montecarlo
 
     top = argparse.ArgumentParser(prog="lptv")
     sub = top.add_subparsers(dest="command")
     parsers = {"demo": cli._demo_parser(sub), "identify": fileid.add_parser(sub),
-               "montecarlo": montecarlo.add_parser(sub), "select": choose.add_parser(sub)}
+               "montecarlo": montecarlo.add_parser(sub), "select": choose.add_parser(sub),
+               "inspect": inspectrec.add_parser(sub)}
     out = {}
     for command, p in parsers.items():
         out[command] = {s for a in p._actions for s in a.option_strings

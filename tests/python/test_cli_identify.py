@@ -186,8 +186,8 @@ def test_warnings_are_printed_and_kept(small, tmp_path, capsys):
         ref = lptv.identify(u, y, na=1, nb=0, ka=1, kb=1, w0=W0_SMALL, ts=TS)
     rc, out, err = identify_cli(capsys, src, "--na", 1, "--nb", 0, "--ka", 1, "--kb", 1,
                                 "--ts", TS, "--out", tmp_path / "o")
-    # the data do not determine the over-parametrised model: not called consistent, exit status 3
-    assert rc == 3 and err == ""
+    # the data do not determine the over-parametrised model: not called consistent, exit status 4
+    assert rc == 4 and err == ""
     assert "verdict: NOT DETERMINED" in out
     assert f"warning: {ref.warnings[0]}" in out.splitlines()
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["warnings"] == list(ref.warnings)

@@ -21,8 +21,9 @@ The period comes from ``--w0`` (rad/s), ``--period`` (s), the file's ``w0`` or, 
 from ``--ts`` and the samples per period. The command writes ``model.json`` (readable by
 :meth:`lptv.Model.load`), ``report.html`` with the validation figures, and ``summary.json``, and
 prints the validation verdict. Exit status: 0 when the verdict calls the model consistent with
-the data, 3 when it does not (MODEL ERRORS, or NOT DETERMINED), 2 for a file or options that
-cannot be used (a one-line error), 1 for a computation that failed. Before the fit the record
+the data, 3 when it finds model errors (MODEL ERRORS), 4 when the data do not determine the
+model (NOT DETERMINED), 2 for a file or options that cannot be used (a one-line error), 1 for a
+computation that failed. Before the fit the record
 is diagnosed as ``lptv inspect`` does: a period (``--period``, ``--w0``, ``--periods``, the
 file's) that is not the one the input repeats at, nor a multiple of it, an ``--fs`` that
 contradicts the file's time, and a record that does not repeat are errors that name the cause
@@ -159,7 +160,7 @@ or stored fs) and the period (--period / --w0); the first line of the output say
 Writes model.json, report.html and summary.json, and prints the validation verdict. The period
 is checked against the one the input repeats at (lptv inspect FILE shows it; --no-period-check
 skips the check). Exit status 0: the model is consistent with the data; 3: the verdict finds
-model errors (or the data do not determine the model); 2: a file or option that cannot be used;
+model errors; 4: the data do not determine the model; 2: a file or option that cannot be used;
 1: a computation that failed.
 Several files (or --workers / --scheduler) make a batch: one row per file in results.csv,
 each model in models/, the fits on local processes or a Dask cluster. With --joint the files
@@ -358,12 +359,13 @@ def run(args) -> int:
         try:
             meas = read_record(src, args, realisations=True)
         except FileError as e:
-            raise FileError(_read_failure_cause(diag, args, e)) from None
+            cause = _read_failure_cause(diag, args, e)
+            raise FileError(cause if cause == str(e) else f"{cause} (--no-period-check skips the check)") from None
         if meas.realisations:
             diag = None
         checked = inspectrec.setup_problem(diag, args, meas.u.shape[-1])
         if checked and not args.no_period_check:
-            raise FileError(checked)
+            raise FileError(f"{checked} (--no-period-check fits the record as cut anyway)")
         output_note = inspectrec.output_period_note(diag, meas.u.shape[-1])
         if args.discrete and args.ts is not None:
             raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
@@ -398,9 +400,13 @@ def run(args) -> int:
     except NumericalError as e:
         return _fail(src, e, status=1)
     except (FileError, ValueError) as e:
-        if not isinstance(e, FileError) and diag is not None and meas is not None and not args.no_period_check \
+        if not isinstance(e, FileError) and diag is not None and meas is not None \
                 and re.match(r"(u|y): |lines: only", str(e)):
-            e = inspectrec.failure_cause(diag, args, meas.u.shape[-1]) or e
+            cause = inspectrec.failure_cause(diag, args, meas.u.shape[-1])
+            if cause and args.no_period_check:
+                e = f"{e}; the record itself says: {cause}"
+            elif cause:
+                e = cause
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
     extra = ([f"{checked} (kept by --no-period-check)"] if checked else []) \

@@ -157,7 +157,7 @@ def setup_problem(insp, args, samples_per_period=None):
     given_fs = f"--fs {args.fs:g}" if args.fs is not None else (f"--dt {args.dt:g}" if args.dt is not None else None)
     if given_fs and insp.file_fs is not None and not np.isclose(insp.fs, insp.file_fs, rtol=1e-6, atol=0):
         return (f"{given_fs} contradicts the file's {insp.file_fs_source} ({insp.file_fs:.10g} Hz): leave "
-                f"{given_fs.split()[0]} out, or name the time's unit (time [ms]), or --no-period-check to use it anyway")
+                f"{given_fs.split()[0]} out, or name the time's unit (time [ms])")
     if not insp.repeats:
         return not_repeating(insp)
     if samples_per_period is None:
@@ -171,7 +171,7 @@ def not_repeating(insp) -> str:
     return (f"the record does not repeat at any period up to {insp.seconds(insp.max_period_samples, 'half the record')}"
             f": the input's best lag leaves {100 * min(insp.repeat_ratio, 9.99):.3g} % of its power unexplained; it "
             "is not a record of periods: identify it as one record with its transient (lptv.identify_record in "
-            "Python), or --no-period-check to fit it as periods anyway")
+            "Python)")
 
 
 def wrong_period(insp, args, samples_per_period) -> str:
@@ -180,21 +180,24 @@ def wrong_period(insp, args, samples_per_period) -> str:
     if N != insp.input_period_samples:
         found += f" and the output every {insp.seconds(N)}"
     opt = period_option(args)
-    if insp.fs is not None:
-        fix = f"use --period {N / insp.fs:.12g}"
-    else:
-        fix = f"use --periods {insp.periods}" + (" with the first samples dropped" if insp.leftover else "")
+    by_count = f"use --periods {insp.periods}" + (f" after dropping the first {insp.leftover} samples"
+                                                   if insp.leftover else "")
+    fix = f"use --period {N / insp.fs:.12g}" if insp.fs is not None else by_count
     if opt is not None:
         said = f"not every {opt[1]:g} s ({opt[0]}"
         said += f", {samples_per_period:g} samples)" if insp.fs is not None else ")"
+        if insp.fs is not None and not insp.fs_given and insp.fs_source:
+            said += f" at the {insp.fs:g} Hz of the file's {insp.fs_source}"
+        elif insp.fs is not None:
+            fix += f", or correct --fs ({N:g} samples in {opt[1]:g} s is {N / opt[1]:.6g} Hz)"
     elif args.periods is not None:
-        said = f"not every {samples_per_period:g} samples (--periods {args.periods})"
+        said, fix = f"not every {samples_per_period:g} samples (--periods {args.periods})", by_count
     elif insp.stored_period is not None:
         said = f"not every {samples_per_period:g} samples (the file's periods x samples arrays)"
         fix = "store the record as one long vector, or as periods of that length"
     else:
         said = f"not every {insp.seconds(samples_per_period)} (the file's w0 or fs)"
-    return f"{found}, {said}: {fix} (or --no-period-check to keep yours)"
+    return f"{found}, {said}: {fix}"
 
 
 def output_period_note(insp, samples_per_period):

@@ -28,14 +28,20 @@ MAX_EXPANDED = 2**26
 
 
 MODEL_REJECTED = 3
-"""The exit status of ``lptv identify FILE`` when the verdict does not call the model consistent with
-the data (MODEL ERRORS, or NOT DETERMINED); 0 when it does, 2 for a file or options that cannot be
-used, 1 for a computation that failed."""
+"""The exit status of ``lptv identify FILE`` when the verdict finds model errors (MODEL ERRORS);
+0 when it calls the model consistent with the data, :data:`NOT_DETERMINED` when the data cannot
+decide, 2 for a file or options that cannot be used, 1 for a computation that failed."""
+NOT_DETERMINED = 4
+"""The exit status when the verdict cannot call the model consistent though it finds no error
+(NOT DETERMINED: too little signal for the structure, or too few realisations to judge)."""
 
 
 def verdict_status(res) -> int:
-    """0 for a model the verdict calls consistent with the data, else :data:`MODEL_REJECTED`."""
-    return 0 if res.model_ok and res.undetermined is None else MODEL_REJECTED
+    """0 for a model the verdict calls consistent with the data, :data:`MODEL_REJECTED` when it
+    finds model errors, :data:`NOT_DETERMINED` when the data do not determine the model."""
+    if not res.model_ok:
+        return MODEL_REJECTED
+    return 0 if res.undetermined is None else NOT_DETERMINED
 
 
 class Parser(argparse.ArgumentParser):
