@@ -458,7 +458,9 @@ def _csv_periods(raw, split):
     what_u, what_y = (f"column '{n}'" for n in raw.names)
     u = split.vector(what_u, raw.u)
     _not_transposed(what_u, u, raw.u, split)
-    return u, split.vector(what_y, raw.y)
+    y = split.vector(what_y, raw.y)
+    _not_transposed(what_y, y, raw.y, split)     # a constant input cannot tell: the output can
+    return u, y
 
 
 def _not_transposed(what, a, samples, split):
@@ -560,11 +562,11 @@ def _as_periods(name, a, split, role):
         v = split.vector(what, a.ravel())
         if v is None:
             raise FileError(f"{what} is a vector of {a.size} samples: give {split.missing()}")
-        if np.all(np.isfinite(v)) and role == "u":
+        if np.all(np.isfinite(v)):          # either channel: a constant input cannot tell
             _not_transposed(what, v, a.ravel(), split)
         a = v
     else:
-        if np.all(np.isfinite(a)) and role == "u" and (periods is None or a.shape[0] == periods):
+        if np.all(np.isfinite(a)) and (periods is None or a.shape[0] == periods):
             _not_transposed(what, a, None, split)
         if periods is not None and a.shape[0] != periods:
             raise FileError(f"{what} holds {a.shape[0]} periods ({_shape(a)}) but --periods says {periods}")

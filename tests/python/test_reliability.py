@@ -261,3 +261,25 @@ def test_a_batch_with_model_errors_exits_3_and_says_which(tmp_path, capsys):
     assert cli.main(base + ["--ka", "3", "--kb", "3", "--out", str(tmp_path / "lptv")]) == 0
     with open(tmp_path / "lptv" / "results.csv") as f:
         assert [r["model_ok"] for r in csv.DictReader(f)] == ["True", "True"]
+
+
+@pytest.mark.parametrize("suffix", [".mat", ".npz", ".csv"])
+def test_a_transposed_record_with_a_constant_input_is_refused(tmp_path, suffix):
+    """The input cannot tell a transposed record (a constant repeats either way); the output can."""
+    import scipy.io
+
+    rng = np.random.default_rng(0)
+    P, N = 4, 256
+    n = np.arange(N)
+    y = np.tile(np.sin(2 * np.pi * 3 * n / N) + 0.3 * np.sin(2 * np.pi * 7 * n / N), (P, 1))
+    y += 0.01 * rng.standard_normal((P, N))
+    u = np.ones((P, N))
+    p = tmp_path / ("r" + suffix)
+    if suffix == ".mat":
+        scipy.io.savemat(p, {"u": u.T, "y": y.T})
+    elif suffix == ".npz":
+        np.savez(p, u=u.T, y=y.T)
+    else:   # the counts exchanged: 256 periods of 4 samples
+        p.write_text("u,y\n" + "".join(f"{a},{b}\n" for a, b in zip(u.ravel(), y.ravel())))
+    with pytest.raises(FileError, match=r"'y'.*(transposed|--periods)"):
+        lptv.read_measurements(p, **({"periods": 256} if suffix == ".csv" else {}))
