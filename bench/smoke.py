@@ -50,6 +50,7 @@ SMOKE = {
     "bench_floquet.py": ["--rounds", "1", "--inner", "1"],
     "bench_htf_overlap.py": ["1"],
     "bench_identifiability.py": ["2"],
+    "bench_inspect.py": ["--runs", "12"],
     "bench_ml_lti.py": ["--rounds", "1", "--inner", "1", "--fditools", ""],
     "bench_moderation_core.py": ["1"],
     "bench_multi_experiment.py": ["3"],

@@ -41,9 +41,11 @@ NOISE_HALF_WINDOW = 20
 WEAK_INPUT_DB = 40.0
 """Input lines above the noise but this far below the median excited line are not counted as
 excitation (an actuator's distortion, leakage), only reported."""
-FRACTIONAL = 0.25
-"""A period further than this from a whole number of samples is reported (the generator and
-the sampling clocks are not synchronised: the spectra leak)."""
+WHOLE = 0.05
+"""A period refined to within this of a whole number of samples is whole (measured: within 0.008
+on records with whole periods at 0.5-10 % noise). Among the lags that repeat, the shortest whole
+one is the period; a period further from a whole number is reported (the generator and the
+sampling clocks are not synchronised: the spectra leak)."""
 
 
 @dataclass(frozen=True)
@@ -367,12 +369,14 @@ def _describe_lines(lines, s):
 # ------------------------------------------------------------------------------ the period
 
 def repeat_residue(x, max_lag: int) -> np.ndarray:
-    """r(L) = sum_i (x[i+L] - x[i])^2 / sum_i ((x[i+L] - m)^2 + (x[i] - m)^2) over the n - L
-    pairs of the record, for L = 0..max_lag (m the mean), by one FFT autocorrelation."""
-    x = np.asarray(x, dtype=float)
-    x = x - x.mean()
+    """r(L) = sum_i (d_i - mean d)^2 / sum_i ((x[i+L] - m)^2 + (x[i] - m)^2) with d_i = x[i+L] - x[i]
+    over the n - L pairs of the record, for L = 0..max_lag, by one FFT autocorrelation, x less
+    its straight line (m = 0). With the line and the differences' mean taken out, a slow linear
+    drift of the channel (a constant d) does not hide the repetition."""
+    x = _detrended(x)
     n = x.size
     c = np.concatenate([[0.0], np.cumsum(x * x)])
+    c1 = np.concatenate([[0.0], np.cumsum(x)])
     from scipy.fft import irfft, next_fast_len, rfft
 
     nfft = next_fast_len(2 * n)
@@ -380,18 +384,26 @@ def repeat_residue(x, max_lag: int) -> np.ndarray:
     R = irfft(X.real ** 2 + X.imag ** 2, nfft)[:max_lag + 1]
     lag = np.arange(max_lag + 1)
     energy = c[n - lag] + (c[n] - c[lag])
-    D = np.maximum(energy - 2.0 * R, 0.0)
+    drift = (c1[n] - c1[lag]) - c1[n - lag]
+    D = np.maximum(energy - 2.0 * R - drift ** 2 / np.maximum(n - lag, 1), 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(energy > 0, D / energy, 1.0)
 
 
+def _detrended(x):
+    """x less its least-squares straight line (a sensor's drift; the periods' shapes stay)."""
+    from scipy.signal import detrend
+
+    return detrend(np.asarray(x, dtype=float), type="linear")
+
+
 def _residue_at(x, lag, start=0):
     """r at one lag, summed directly over the pairs from sample ``start`` (no FFT rounding)."""
-    x = np.asarray(x, dtype=float)
-    x = x[start:] - x[start:].mean()
+    x = _detrended(np.asarray(x, dtype=float)[start:])
     a, b = x[lag:], x[:x.size - lag]
     e = float(np.dot(a, a) + np.dot(b, b))
-    return float(np.sum((a - b) ** 2) / e) if e > 0 else 1.0
+    d = a - b
+    return float(np.sum((d - d.mean()) ** 2) / e) if e > 0 else 1.0
 
 
 def _spread(n, lag):
@@ -415,8 +427,12 @@ def find_period(x, max_lag=None):
     """(period in samples or None, refined period, r array): the shortest lag at which x repeats.
 
     Lags start after r first reaches 1 (the correlation of neighbouring samples no longer holds
-    x together); among them the best one's residue r* must be below REPEAT_LIMIT; the period is
-    the shortest local minimum within SIGMAS noise deviations of r* whose multiples repeat too."""
+    x together). A candidate is a local minimum of r below REPEAT_LIMIT such that (a) none of its
+    multiples repeats better by more than SIGMAS noise deviations (else it is a near repeat, a
+    signal with little power on the lines that tell it from the period), (b) its multiples
+    repeat as well as it does on the record without its first quarter (a narrow band of noise
+    drifts away), (c) refined between samples it is whole to within WHOLE. The shortest
+    candidate is the period; without a whole one the shortest that meets (a) and (b)."""
     x = np.asarray(x, dtype=float)
     n = x.size
     max_lag = n // 2 if max_lag is None else min(max_lag, n // 2)
@@ -429,39 +445,60 @@ def find_period(x, max_lag=None):
     lo = int(past[0]) + 1
     if lo >= max_lag:
         return None, None, r
-    seg = r[lo:max_lag + 1]
-    best = lo + int(np.argmin(seg))
-    r_best = float(r[best])
-    if r_best > REPEAT_LIMIT:
-        return None, None, r
     lag = np.arange(lo, max_lag + 1)
-    ok = r[lo:] <= _bound(r_best, n, best, lag)
     left = np.r_[np.inf, r[lo:-1]]
     right = np.r_[r[lo + 1:], np.inf]
-    candidates = lag[ok & (r[lo:] <= left) & (r[lo:] <= right)]
+    candidates = lag[(r[lo:] <= REPEAT_LIMIT) & (r[lo:] <= left) & (r[lo:] <= right)]
+    if not candidates.size:
+        return None, None, r
+    start = n // 4
+    tail = repeat_residue(x[start:], min(max_lag, n - start - 1))
+    fractional = None
     for L in candidates:
         # the exact sums decide between neighbours (the FFT's rounding may not, at r near 0)
         near = [k for k in (int(L) - 1, int(L), int(L) + 1) if lo <= k <= max_lag]
         L = min(near, key=lambda k: _residue_at(x, k))
         Lf = _refine(x, L)
-        if _multiples_repeat(x, Lf, max_lag, _residue_at(x, L)):
-            return L, Lf, r
+        mult = _multiples(r, Lf, max_lag)
+        r_L = float(r[L])
+        if mult.size and r_L > _bound(float(np.min(r[mult])), n, int(mult[np.argmin(r[mult])]), L):
+            continue                                                      # (a)
+        if not _multiples_repeat(tail, Lf, n - start):
+            continue                                                      # (b)
+        if abs(Lf - L) <= WHOLE:
+            return L, Lf, r                                               # (c)
+        # a lag the signal nearly repeats at between samples (lines on multiples of s with N not
+        # divisible by s: 4/5 of the period is 0.8 N samples): a whole period may follow
+        fractional = fractional or (L, Lf)
+    if fractional is not None:
+        return fractional[0], fractional[1], r
     return None, None, r
 
 
-def _multiples_repeat(x, Lf, max_lag, r_L):
-    """A period repeats at its multiples with the same residue per pair (a transient at the start
-    raises it by at most (n - L) / (n - mL)); a signal that stays similar for a while (a narrow
-    band of noise) drifts away."""
-    n = x.size
-    L = int(round(Lf))
+def _multiples(r, Lf, max_lag):
+    """The lags nearest the multiples 2 Lf, 3 Lf ... up to max_lag, each the best of its three
+    neighbours in r (a period between samples drifts by a fraction of a sample per multiple)."""
+    out = []
     m = 2
     while round(m * Lf) <= max_lag:
         k = int(round(m * Lf))
-        r_k = min(_residue_at(x, j) for j in (k - 1, k, k + 1) if 1 <= j < n)
-        if r_k > (n - L) / (n - k) * _bound(r_L, n, L, k):
-            return False
+        near = [j for j in (k - 1, k, k + 1) if 1 <= j < r.size]
+        out.append(min(near, key=lambda j: r[j]))
         m += 1
+    return np.array(out, dtype=int)
+
+
+def _multiples_repeat(r_tail, Lf, n):
+    """(b): on the record without its first quarter (n samples, residues r_tail), each multiple
+    k L repeats as well as L, to the noise's deviations; what is left of a start-up transient
+    raises the residue at k L by at most (n - L) / (n - k L)."""
+    L = int(round(Lf))
+    if L >= r_tail.size:
+        return True
+    r_L = float(r_tail[L])
+    for k in _multiples(r_tail, Lf, min(r_tail.size - 1, n - L)):
+        if r_tail[k] > (n - L) / (n - k) * _bound(r_L, n, L, k):
+            return False
     return True
 
 
@@ -500,6 +537,22 @@ def _off_grid_lines(y, N, m):
 
 
 # ------------------------------------------------------------------------------ the periods
+
+def _drift(xs):
+    """(change per period, t) of a straight line through the deviations of the periods from
+    their mean, when it stands out of their noise by more than SIGMAS standard errors (the
+    deviations taken as white); else None."""
+    P, N = xs.shape
+    if P < 2:
+        return None
+    dev = (xs - xs.mean(axis=0)).ravel()
+    t = np.arange(dev.size) / N - (dev.size - 1) / (2 * N)
+    slope = float(np.dot(t, dev) / np.dot(t, t))
+    res = dev - slope * t
+    se = math.sqrt(max(float(np.dot(res, res)) / max(dev.size - N - 1, 1), 1e-300) / float(np.dot(t, t)))
+    z = abs(slope) / se
+    return (slope, z) if z > SIGMAS else None
+
 
 def _transient(xs, n_ref):
     """Each leading period against the mean of the last n_ref, over the noise those show."""
@@ -746,13 +799,23 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
     N = m * L
     P = n // N
     left = n - P * N
-    if abs(Lf - L) > FRACTIONAL:
+    if abs(Lf - L) > WHOLE:
         notes.append(f"the period is about {Lf:.2f} samples, not a whole number: the generator's clock and the "
                      "sampling's are not synchronised, and the periods' spectra leak (resample, or synchronise them)")
     if stored is not None and stored != N and not (stored % N == 0):
         notes.append(f"the file's arrays hold periods of {stored} samples, but the record repeats every {N}: "
                      "store it as one long record (or as periods of the right length)")
     us, ys = uu[left:].reshape(P, N), yy[left:].reshape(P, N)
+    drifts = [_drift(xs) for xs in (us, ys)]
+    for name, drift in zip(names, drifts):
+        if drift is not None:
+            notes.append(f"'{name}' drifts by {drift[0]:.3g} per period ({drift[1]:.0f} standard errors): a trend the "
+                         "periods do not share; take it out (--detrend), or the spectra's lowest lines carry it "
+                         "(it is taken out here)")
+    if drifts[0] is not None:
+        us = _detrended(uu[left:]).reshape(P, N)
+    if drifts[1] is not None:
+        ys = _detrended(yy[left:]).reshape(P, N)
     if P >= 3:
         n_ref = max(2, (P + 1) // 2)
         ratios = np.maximum(_transient(us, n_ref), _transient(ys, n_ref))
