@@ -12,14 +12,16 @@ local polynomial method. The NumPy and SciPy route it replaced is :mod:`lptv.ref
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
-from typing import Optional
+from typing import Optional, Tuple
 
 import numpy as np
 
 from . import _core
 from ._validate import as_counts, as_int, as_real_1d
 from .model import Model
+from .record_verdict import RecordVerdict, record_verdict
 
 
 @dataclass(frozen=True)
@@ -61,11 +63,43 @@ class RecordResult:
     converged: bool
     iterations: int
     """Levenberg-Marquardt iterations of the last fit (the residual route fits three times)."""
+    record_verdict: Optional[RecordVerdict] = None
+    """The cross-correlation test of the residual with the input and its shifts
+    (:mod:`lptv.record_verdict`), which needs no noise level: behind :attr:`model_ok`."""
+    warnings: Tuple[str, ...] = ()
+    """What the fit warned about (also issued as warnings): no convergence, a noise level the
+    residual contradicts."""
 
     @property
     def cost_ratio(self) -> float:
         """cost / dof: about 1 when the model and the noise level fit the data."""
         return self.cost / self.dof
+
+    @property
+    def model_errors(self) -> Tuple[str, ...]:
+        """The signs of a model error, each as a sentence (empty when none): the residual
+        explained by the input on the same line (an order too few) or shifted by k w0 (a
+        missing harmonic k), at the verdict's size of 1 %; a fit that did not converge."""
+        errs = () if self.record_verdict is None else self.record_verdict.model_errors
+        if not self.converged:
+            errs = errs + (f"the fit did not converge in {self.iterations} iterations: its estimate is not "
+                           "the likelihood's optimum",)
+        return errs
+
+    @property
+    def model_ok(self) -> bool:
+        """No sign of a model error (:attr:`model_errors` is empty)."""
+        return not self.model_errors
+
+    @property
+    def verdict(self) -> str:
+        """One sentence: is the model consistent with the record, and if not, why."""
+        if self.model_ok:
+            v = self.record_verdict
+            return ("the model is consistent with the record: its residual is not explained by the input or "
+                    f"its shifts by up to {max(v.shifts)} w0 (F = {v.statistic:.3g}, p = {v.p_value:.2g}, "
+                    f"size {100 * v.alpha:g} %)")
+        return "MODEL ERRORS: " + "; ".join(self.model_errors)
 
 
 def _record_periods(n_total, n0, name):
@@ -269,9 +303,24 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         else:
             b[order, Kb + k] = v
     cov_eta = np.asarray(fit.covariance)
+    Y_fit = np.asarray(fit.Y_fit)
+    verdict = record_verdict(U, (Y[lines] - Y_fit) / np.sqrt(var), lines, L, kmax)
+    said = []
+    if not fit.converged:
+        said.append(f"identify_record: the fit did not converge in {int(fit.iterations)} iterations "
+                    f"(max_iterations={max_iterations}); its estimate is not the likelihood's optimum")
+    if isinstance(noise, str) and noise == "lpm":
+        ratio = float(fit.cost) / int(fit.dof)
+        if ratio < 0.25:
+            said.append(f"identify_record: the local polynomial method's noise level is {1 / ratio:.3g} times "
+                        "what the fit's residual shows: it overestimates the noise where the HTF's branches "
+                        "decay slowly (raise lpm_branches), and weighs the lines wrongly; use noise='residual'")
+    for msg in said:
+        warnings.warn(msg, RuntimeWarning, stacklevel=2)
     return RecordResult(
         model=Model(a, b, w0=float(w0), ts=None if continuous else ts), eta=np.asarray(fit.eta), eta_names=list(par.eta_names),
         covariance=cov_eta, parameter_std=np.sqrt(np.diag(cov_eta)), transient=np.asarray(fit.transient),
         transient_std=np.asarray(fit.transient_std), periods=L, lines=lines, noise_var=var,
-        noise_dof=int(noise_dof), Y=Y[lines], Y_fit=np.asarray(fit.Y_fit), cost=float(fit.cost),
-        dof=int(fit.dof), converged=bool(fit.converged), iterations=int(fit.iterations))
+        noise_dof=int(noise_dof), Y=Y[lines], Y_fit=Y_fit, cost=float(fit.cost),
+        dof=int(fit.dof), converged=bool(fit.converged), iterations=int(fit.iterations),
+        record_verdict=verdict, warnings=tuple(said))

@@ -1,0 +1,101 @@
+"""The verdict of one record (METHOD.md section 17): a right structure passes, a wrong one is
+rejected and named, on records simulated outside lptv (a NumPy loop of a difference equation
+with periodic coefficients, scipy.signal.lfilter, scipy.integrate.solve_ivp). The rejection
+rates over hundreds of records are in bench/RESULTS.md (bench/python/bench_record_verdict.py)."""
+import warnings
+
+import numpy as np
+import pytest
+from scipy import integrate, signal
+
+import lptv
+
+
+def discrete_lptv(seed, N0=64, L=8, noise=0.01):
+    """y(t+2) - 1.2 y(t+1) + a0(t) y(t) = 0.5 u(t+1) + b0(t) u(t) from rest, filtered noise in."""
+    rng = np.random.default_rng(seed)
+    N, w0 = N0 * L, 2 * np.pi / N0
+    t = np.arange(N + 2)
+    bf, af = signal.butter(4, 0.4)
+    u = signal.lfilter(bf, af, rng.standard_normal(N + 2))
+    a0, b0 = 0.5 + 0.1 * np.cos(w0 * t + 0.3), 1.0 + 0.1 * np.cos(w0 * t)
+    y = np.zeros(N + 2)
+    for k in range(N):
+        y[k + 2] = 0.5 * u[k + 1] + b0[k] * u[k] + 1.2 * y[k + 1] - a0[k] * y[k]
+    return u[:N], y[:N] + noise * np.std(y[:N]) * rng.standard_normal(N), w0
+
+
+def fit(u, y, w0, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return lptv.identify_record(u, y, w0=w0, ts=1.0, **kw)
+
+
+RIGHT = dict(na=2, nb=1, ka=[1, 0, 0], kb=[1, 0])
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_right_structure_passes_and_wrong_ones_are_named(seed):
+    u, y, w0 = discrete_lptv(seed)
+    right = fit(u, y, w0, **RIGHT)
+    assert right.model_ok, right.verdict
+    assert right.verdict.startswith("the model is consistent with the record")
+    few = fit(u, y, w0, na=1, nb=1, ka=[1, 0], kb=[1, 0])
+    assert not few.model_ok and any("k = 0" in e and "order too few" in e for e in few.model_errors), few.verdict
+    lti_b = fit(u, y, w0, na=2, nb=1, ka=[1, 0, 0], kb=[0, 0])        # b0's 5 % harmonic missing
+    assert not lti_b.model_ok and any("harmonic 1 missing" in e for e in lti_b.model_errors), lti_b.verdict
+    # the cost ratio cannot tell them apart: the residual's noise level absorbs the error
+    assert 0.85 < few.cost_ratio < 1.1 and 0.85 < lti_b.cost_ratio < 1.1
+
+
+def test_the_verdict_needs_no_noise_level():
+    """Its statistic is a ratio of the residual's parts: the same for y and 1000 y, and for a
+    noise level given ten times too high or too low."""
+    u, y, w0 = discrete_lptv(5)
+    ref = fit(u, y, w0, **RIGHT).record_verdict
+    assert fit(u, 1000 * y, w0, **RIGHT).record_verdict.statistic == pytest.approx(ref.statistic, rel=1e-6)
+    few = fit(u, y, w0, na=1, nb=1, ka=[1, 0], kb=[1, 0])
+    for scale in (0.1, 10.0):
+        var = scale * np.mean(few.noise_var)
+        given = fit(u, y, w0, na=1, nb=1, ka=[1, 0], kb=[1, 0], noise=var)
+        assert not given.model_ok
+
+
+def test_an_lti_record_from_lfilter():
+    rng = np.random.default_rng(3)
+    b, a = signal.butter(3, 0.3)
+    u = signal.lfilter(*signal.butter(4, 0.5), rng.standard_normal(512))
+    y = signal.lfilter(np.r_[0.0, b[:-1]], a, u)
+    y = y + 0.02 * np.std(y) * rng.standard_normal(512)
+    assert fit(u, y, 2 * np.pi / 64, na=3, nb=2).model_ok
+    assert not fit(u, y, 2 * np.pi / 64, na=2, nb=1).model_ok
+
+
+def test_a_continuous_time_record_from_solve_ivp():
+    """m x'' + c x' + k(t) x = f, k = 4 (1 + 0.1 cos(w0 t)), 8 periods of 128 samples."""
+    rng = np.random.default_rng(2)
+    period, N0, L = 10.0, 128, 8
+    w0, ts = 2 * np.pi / period, period / N0
+    freqs, amps = rng.uniform(0.05, 0.25 * np.pi / ts, 40), rng.standard_normal(40) / np.sqrt(20)
+    phases = rng.uniform(0, 2 * np.pi, 40)
+
+    def f(t):
+        return np.sum(amps * np.cos(freqs * t + phases))
+
+    tt = np.arange(N0 * L) * ts
+    sol = integrate.solve_ivp(lambda t, s: [s[1], f(t) - 0.4 * s[1] - 4 * (1 + 0.1 * np.cos(w0 * t)) * s[0]],
+                              (0, tt[-1]), [0.0, 0.0], t_eval=tt, rtol=1e-10, atol=1e-12, method="DOP853")
+    u, y = np.array([f(t) for t in tt]), sol.y[0] + 0.01 * np.std(sol.y[0]) * rng.standard_normal(tt.size)
+    kw = dict(w0=w0, ts=ts, continuous=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert lptv.identify_record(u, y, na=2, nb=0, ka=[1, 0, 0], kb=0, **kw).model_ok
+        lti = lptv.identify_record(u, y, na=2, nb=0, **kw)
+    assert not lti.model_ok and any("harmonic 1 missing" in e for e in lti.model_errors), lti.verdict
+
+
+def test_a_fit_that_does_not_converge_warns_and_is_a_model_error():
+    u, y, w0 = discrete_lptv(1)
+    with pytest.warns(RuntimeWarning, match="did not converge in 1 iterations"):
+        r = lptv.identify_record(u, y, w0=w0, ts=1.0, max_iterations=1, **RIGHT)
+    assert not r.converged and not r.model_ok and "did not converge" in r.verdict
