@@ -99,3 +99,44 @@ def test_a_fit_that_does_not_converge_warns_and_is_a_model_error():
     with pytest.warns(RuntimeWarning, match="did not converge in 1 iterations"):
         r = lptv.identify_record(u, y, w0=w0, ts=1.0, max_iterations=1, **RIGHT)
     assert not r.converged and not r.model_ok and "did not converge" in r.verdict
+
+
+def _rig_csv(path, seed=2, L=8):
+    """The continuous-time record above as a rig writes it: time, force and displacement columns."""
+    rng = np.random.default_rng(seed)
+    period, N0 = 10.0, 128
+    w0, ts = 2 * np.pi / period, period / N0
+    freqs, amps = rng.uniform(0.05, 0.25 * np.pi / ts, 40), rng.standard_normal(40) / np.sqrt(20)
+    phases = rng.uniform(0, 2 * np.pi, 40)
+
+    def f(t):
+        return np.sum(amps * np.cos(freqs * t + phases))
+
+    tt = np.arange(N0 * L) * ts
+    sol = integrate.solve_ivp(lambda t, s: [s[1], f(t) - 0.4 * s[1] - 4 * (1 + 0.1 * np.cos(w0 * t)) * s[0]],
+                              (0, tt[-1]), [0.0, 0.0], t_eval=tt, rtol=1e-10, atol=1e-12, method="DOP853")
+    u, y = np.array([f(t) for t in tt]), sol.y[0] + 0.01 * np.std(sol.y[0]) * rng.standard_normal(tt.size)
+    np.savetxt(path, np.c_[tt, u, y], delimiter=",", header="time [s],force [N],displacement [m]", comments="")
+    return path
+
+
+def test_the_command_line_route_writes_the_model_and_exits_by_the_verdict(tmp_path, capsys):
+    from lptv.apps import cli
+
+    src = _rig_csv(tmp_path / "rig.csv")
+    base = ["identify", str(src), "--one-record", "--input", "force", "--output", "displacement", "--period", "10",
+            "--na", "2", "--nb", "0", "--kb", "0"]
+    assert cli.main(base + ["--ka", "1,0,0", "--out", str(tmp_path / "right")]) == 0
+    out = capsys.readouterr().out
+    assert "one record of 8 periods of 128 samples" in out and "consistent with the record" in out, out
+    for name in ("model.json", "summary.json", "report.html"):
+        assert (tmp_path / "right" / name).exists(), name
+    m = lptv.Model.load(tmp_path / "right" / "model.json")
+    assert m.ts is None and m.na == 2
+    # the stiffness's variation: a0 = k0 (1 + 0.1 cos) / m, its first harmonic 0.05 k0 = 0.2
+    assert abs(m.a[0, m.ka + 1]) == pytest.approx(0.2, rel=0.1)
+    assert cli.main(base + ["--ka", "0", "--out", str(tmp_path / "lti")]) == 3
+    assert "MODEL ERRORS" in capsys.readouterr().out
+    no_period = [a for a in base if a not in ("--period", "10")]
+    assert cli.main(no_period + ["--out", str(tmp_path / "x")]) == 2
+    assert "needs the parameters' period" in capsys.readouterr().err

@@ -192,6 +192,10 @@ def add_parser(sub):
                    help="sampling frequency of the record (Hz); the model stays continuous-time. With the "
                         "period it gives the samples per period and splits a long record into whole periods")
     s.add_argument("--dt", type=float, metavar="S", help="sampling time of the record (s), 1 / fs")
+    p.add_argument("--one-record", action="store_true",
+                   help="the file is one record that does not repeat (a start-up transient, an input that is "
+                   "not periodic): fit it whole with its transient (lptv.identify_record); needs --period "
+                   "or --w0 and the sampling frequency")
     p.add_argument("--discrete", action="store_true",
                    help="identify a discrete-time model (in the shift z) with the sample period 1 / fs")
     p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "
@@ -333,6 +337,14 @@ def run(args) -> int:
         print("lptv identify: error: --resume applies to a batch of files (several files, --workers or "
               "--scheduler), not to one record or --joint", file=sys.stderr)
         return 2
+    if getattr(args, "one_record", False):
+        if args.joint or len(args.files) > 1 or args.workers is not None or args.scheduler is not None:
+            print("lptv identify: error: --one-record takes one file (not several files, --joint, --workers or "
+                  "--scheduler)", file=sys.stderr)
+            return 2
+        from lptv.apps import recordid
+
+        return recordid.run(args, OPTION_NAMES)
     if args.joint:
         from lptv.apps import jointid
 
