@@ -245,8 +245,9 @@ class Inspection:
                        f"{self.seconds(self.max_period_samples, 'half the record')}"
                        f"; the best lag leaves {100 * min(self.repeat_ratio, 9.99):.3g} % of its power unexplained")
             out.append("route:       not a periodic record: identify it as one record with its transient, "
-                       "lptv.identify_record(u, y, na=..., nb=..., w0=2 pi / T, ts=1 / fs) in Python "
-                       "(T the system's period, known from the set-up)")
+                       f"lptv identify {shlex.quote(self.source)} --one-record --period T ... "
+                       "(lptv.identify_record(u, y, na=..., nb=..., w0=2 pi / T, ts=1 / fs) in Python; "
+                       "T the system's period, known from the set-up)")
             out += [f"note:        {n}" for n in self.notes]
             return "\n".join(out)
         N, L = self.period_samples, self.input_period_samples

@@ -134,7 +134,7 @@ def test_a_record_that_does_not_repeat_is_said_to_and_the_one_record_route_named
     assert not r.repeats and r.command is None and r.repeat_ratio > 0.2
     s = r.summary()
     assert "does not repeat at any lag up to 20.000 s (4000 samples, half the record)" in s
-    assert "lptv.identify_record" in s
+    assert "--one-record --period T" in s and "lptv.identify_record" in s
 
 
 def test_a_dead_input_is_refused_as_dead():
@@ -187,7 +187,7 @@ def test_identify_names_a_record_that_does_not_repeat(tmp_path, capsys):
     rc, out, err = cli_run(capsys, "identify", src, *NAMES, *RIGHT, "--period", 5, "--out", tmp_path / "o")
     assert rc == 2 and err.count("\n") == 1
     assert "the record does not repeat at any period up to 20.000 s" in err
-    assert "identify it as one record" in err and "lptv.identify_record" in err and "dead" not in err
+    assert "identify it as one record" in err and "--one-record" in err and "dead" not in err
 
 
 def test_identify_names_an_output_that_does_not_repeat_with_the_input(records, tmp_path, capsys):

@@ -151,3 +151,34 @@ def test_readme_noise_alone_example_runs(tmp_path, monkeypatch):
     dof = bla.covariance_dof[free]
     assert np.all(z < 1.959964 * stats.t.ppf(0.9995, dof) / stats.t.ppf(0.975, dof))
     assert np.all(z < 10)     # (0.05-4.3 here: the t_1 intervals are wide, the estimates are not)
+
+
+def test_readme_inspect_example_runs(tmp_path, monkeypatch, capsys):
+    """The record the block makes: 1163 samples of a 200-sample period from sample 37 on, so 5
+    whole periods and 163 samples before them; the filter starts from rest (a transient); the
+    commands and the messages the README quotes are what the command prints."""
+    import shlex
+
+    from lptv.apps import cli
+
+    ns = run_block("lptv.inspect(", tmp_path, monkeypatch)
+    insp = ns["insp"]
+    assert (insp.period, insp.periods, insp.leftover) == (4.0, 5, 163) and insp.transient_periods >= 1
+    assert insp.lines.tolist() == list(range(1, 40, 2))
+    text = README.read_text()
+    printed = capsys.readouterr().out
+    assert f"{insp.period} {insp.periods} {insp.leftover} {insp.transient_periods}" in printed
+    assert f"# 4.0 5 163 {insp.transient_periods}" in text
+    suggested = re.search(r"The suggested command \(`(lptv identify rig.csv[^`]*)`\)", text, flags=re.S).group(1)
+    assert " ".join(suggested.split()) == insp.command
+    cmd = re.search(r"```sh\n(lptv inspect rig\.csv[^#\n]*)", text).group(1)
+    assert cli.main(shlex.split(cmd)[1:]) == 0 and (tmp_path / "rig-inspect" / "report.html").exists()
+    capsys.readouterr()
+    base = ["identify", "rig.csv", "--input", "force", "--output", "displacement", "--na", "1", "--nb", "0"]
+    flat = " ".join(text.split())
+    for extra, quoted in ((["--period", "5"], "the input repeats every 4.00 s (200 samples), not every 5 s"),
+                          (["--period", "4", "--fs", "100"], "--fs 100 contradicts the file's column 'time [s]' (50 Hz)")):
+        assert cli.main(base + extra) == 2
+        err = capsys.readouterr().err
+        start = flat.index(quoted)
+        assert flat[start:flat.index("`", start)] in err

@@ -170,8 +170,8 @@ def setup_problem(insp, args, samples_per_period=None):
 def not_repeating(insp) -> str:
     return (f"the record does not repeat at any period up to {insp.seconds(insp.max_period_samples, 'half the record')}"
             f": the input's best lag leaves {100 * min(insp.repeat_ratio, 9.99):.3g} % of its power unexplained; it "
-            "is not a record of periods: identify it as one record with its transient (lptv.identify_record in "
-            "Python)")
+            "is not a record of periods: identify it as one record with its transient (--one-record; "
+            "lptv.identify_record in Python)")
 
 
 def wrong_period(insp, args, samples_per_period) -> str:
