@@ -18,11 +18,13 @@ _NAME = re.compile(r"([ab])(\d+)\.(re|im)(\d+)")
 
 
 def _source(obj):
-    """(model, eta names, eta values, covariance or None) of a result or a model."""
-    from .identify import IdentificationResult
+    """(model, eta names, eta values, covariance or None) of a result or a model. A result is
+    anything with a model, eta_names, eta and covariance (lptv.identify's, identify_record's):
+    read by its attributes, so that this module imports no result type (which imports it)."""
     from .model import Model
 
-    if isinstance(obj, IdentificationResult):
+    if not isinstance(obj, Model) and all(hasattr(obj, a) for a in ("model", "eta_names", "eta", "covariance")) \
+            and isinstance(obj.model, Model):
         return obj.model, tuple(obj.eta_names), np.asarray(obj.eta, float), obj.covariance
     if isinstance(obj, Model):
         names = tuple(obj.eta_names)

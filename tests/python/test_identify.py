@@ -235,7 +235,7 @@ def test_error_single_period(small_periods):
 
 def test_error_lines_outside_grid(small_periods):
     u, y = small_periods
-    with pytest.raises(ValueError, match="lines: row 100 needs lines up to 101"):
+    with pytest.raises(ValueError, match="lines: line 100 lies above the Nyquist line 32 of the data"):
         lptv.identify(u, y, lines=[5, 100], **KW)
     with pytest.raises(ValueError, match="lines: row 0 is not a positive line"):
         lptv.identify(u, y, lines=range(0, 10), **KW)

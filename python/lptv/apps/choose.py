@@ -27,7 +27,7 @@ import numpy as np
 
 from lptv import read_measurements, select
 from lptv.atomic import atomic_open
-from lptv.apps.fileid import parse_lines, positive
+from lptv.apps.options import parse_lines, positive
 from lptv.apps.options import bounded_range, in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import write_json

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import identify_many
-from lptv.apps.fileid import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive, read_options
+from lptv.apps.options import OPTION_NAMES, parse_counts, parse_known, parse_lines, positive, read_options
 from lptv.apps.options import Interrupted, in_option_terms, integer, interruptible, output_folder
 from lptv.batch.executors import LOST
 from lptv.batch.parts import CheckpointError, clear, stored_items

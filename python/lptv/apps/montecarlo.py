@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import METHODS, Model, NumericalError, montecarlo, multisine
-from lptv.apps.fileid import parse_lines
+from lptv.apps.options import parse_lines
 from lptv.apps.options import Interrupted, in_option_terms, integer, interruptible, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import Report, write_json

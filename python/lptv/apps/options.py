@@ -19,7 +19,9 @@ import tempfile
 import threading
 from pathlib import Path
 
-from lptv.measurements import FileError
+import numpy as np
+
+from lptv.measurements import FileError, read_measurements
 
 INT_MAX = 2**31 - 1
 """The largest integer the core takes (a C int)."""
@@ -140,3 +142,129 @@ def interruptible():
         if not interrupted:
             for s, h in old.items():
                 signal.signal(s, h)
+
+
+# ------------------------------------------------------------------------------ what lptv identify's
+# commands share (one file, a batch, --joint, select, montecarlo): the options' parsing
+
+def parse_lines(text: str, opt: str = "--lines"):
+    """'1-243', '1-100,120-150' or '10,20,30' -> the line numbers, in the order given;
+    'excited' -> 'excited' (the lines the input excites, +-K for an LPTV model)."""
+    if text.strip().lower() == "excited":
+        return "excited"
+    spans, total = [], 0
+    for tok in text.split(","):
+        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", tok)
+        if not m:
+            raise FileError(f"{opt}: '{tok.strip()}' is not a line number or a range like 1-243")
+        lo = int(m.group(1))
+        hi = int(m.group(2)) if m.group(2) else lo
+        if hi < lo:
+            raise FileError(f"{opt}: '{tok.strip()}' is an empty range")
+        r = bounded_range(lo, hi, opt, tok.strip(), MAX_EXPANDED - total)
+        spans.append((r.start, r.stop - 1))
+        total += len(r)
+    # repeats by the ranges, sorted (a list of every line cost 36 bytes a line to check)
+    ordered = sorted(spans)
+    for (lo0, hi0), (lo1, _) in zip(ordered, ordered[1:]):
+        if lo1 <= hi0:
+            raise FileError(f"{opt}: line {lo1} is given twice")
+    # as 64-bit integers, 8 bytes a line: the library names lines above the data's Nyquist line
+    return np.concatenate([np.arange(lo, hi + 1, dtype=np.int64) for lo, hi in spans])
+
+
+def parse_counts(text, opt):
+    try:
+        ks = [int(t) for t in text.split(",")]
+    except ValueError:
+        raise FileError(f"{opt}: '{text}' must be an integer or a comma list of integers, "
+                        "one per coefficient") from None
+    if any(k < 0 for k in ks):
+        raise FileError(f"{opt}: harmonic counts must be >= 0, got '{text}'")
+    return ks[0] if len(ks) == 1 else ks
+
+
+def parse_known(text):
+    if text is None:
+        return None
+    out = {}
+    for tok in text.split(","):
+        name, eq, value = tok.partition("=")
+        name = name.strip()
+        try:
+            v = float(value)
+        except ValueError:
+            v = None
+        if not eq or not name or v is None or not np.isfinite(v):
+            raise FileError(f"--known: '{tok.strip()}' is not of the form name=number (e.g. a2=1.5)")
+        if name in out:
+            raise FileError(f"--known: {name} is given twice")
+        out[name] = v
+    return out
+
+
+def positive(value, opt):
+    if value is not None and not (np.isfinite(value) and value > 0):
+        raise FileError(f"{opt} must be a positive number, got {value:g}")
+    return value
+
+
+def fundamental(args, meas):
+    """w0 from --w0 / --period, the file, and (discrete time) --ts with the samples per period."""
+    w0 = positive(args.w0, "--w0")
+    if positive(args.period, "--period") is not None:
+        w0 = 2 * np.pi / args.period
+    given = "--w0" if args.w0 is not None else "--period"
+    if meas.w0 is not None:
+        if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
+            raise FileError(f"{given} gives w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
+        if w0 is None:
+            w0, given = meas.w0, "the file's w0"
+    if meas.fs is not None and w0 is None:
+        w0 = 2 * np.pi * meas.fs / meas.u.shape[-1]
+    if positive(args.ts, "--ts") is not None:
+        n = meas.u.shape[-1]
+        w0_ts = 2 * np.pi / (n * args.ts)
+        if w0 is None:
+            w0 = w0_ts
+        elif not np.isclose(w0, w0_ts, rtol=1e-9, atol=0):
+            # the library would accept it, with the lines mapped to the wrong frequencies
+            raise FileError(f"{given} and --ts {args.ts:g} give {2 * np.pi / (w0 * args.ts):.6g} "
+                            f"samples per period, but the record has {n}")
+    if w0 is None:
+        raise FileError("the period is unknown: give --w0 (rad/s) or --period (s)")
+    return w0
+
+
+OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_iter": "--max-iter",
+                "tol": "--tol", "lines": "--lines", "known": "--known", "method": "--method", "w0": "--w0",
+                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap", "noise": "--noise",
+                "disturbances": "--remove-disturbances"}
+"""The arguments of lptv.identify and the options that set them, for the messages."""
+
+
+def read_options(args) -> dict:
+    """The keyword arguments of lptv.read_measurements the options give (--periods, --fs / --dt,
+    --period or --w0, --trim, --skip-periods, --input, --output, --time, --detrend)."""
+    period = positive(args.period, "--period")
+    if period is None and positive(args.w0, "--w0") is not None:
+        period = 2 * np.pi / args.w0
+    return dict(periods=args.periods, fs=args.fs, dt=args.dt, period=period, trim=args.trim,
+                skip_periods=args.skip_periods, u=args.input, y=args.output, time=args.time,
+                detrend=getattr(args, "detrend", False))
+
+
+def read_record(src, args, realisations: bool = False):
+    """The periods of one file as the options say (:func:`read_options`); with ``realisations``
+    also M x P x N records of random-phase realisations."""
+    return read_measurements(src, **read_options(args), realisations=realisations)
+
+
+def describe_record(meas) -> str:
+    """', fs = 50 Hz from column 'time', input 'force', output 'disp'' (what the first line says)."""
+    text = ""
+    if meas.fs:
+        text += f", fs = {meas.fs:g} Hz" + (f" from {meas.fs_source}" if meas.fs_source else "")
+    if (meas.input, meas.output) != ("u", "y"):
+        text += f", input '{meas.input}', output '{meas.output}'"
+    return text

@@ -47,12 +47,11 @@ import sys
 import time
 import traceback
 import weakref
-from dataclasses import dataclass
 from typing import Any, Callable, List, Optional, Sequence
 
+from .common import EXTRA, Failure, _call, _one_line, one_blas_thread, require  # noqa: F401 - their names here too
 from .warm import discard_pool, kept_pool, malloc_kept
 
-EXTRA = "pip install 'lptv[batch]'"
 # Largest chunk: 32 fits of ~12 ms are ~0.4 s, against ~1-3 ms of per-task overhead on Dask
 # (bench/RESULTS.md), while leaving several chunks per worker for balance and for the ETA.
 MAX_CHUNK = 32
@@ -66,62 +65,6 @@ TASK_MIN, TASK_MIN_DASK, TASK_MAX = 0.01, 0.04, 0.4
 FIRST_SHARE = 0.75
 
 _cost = {}   # (module, qualified name) of a task function -> seconds per item, last measured
-
-
-@dataclass(frozen=True)
-class Failure:
-    """What :func:`run_tasks` gives for an item whose task raised: the error, on one line."""
-
-    message: str
-    detail: str = ""
-    """The traceback (or the reason the chunk was lost)."""
-
-
-def require(module: str, what: str):
-    """Import an optional dependency, or raise ImportError naming the extra that brings it."""
-    import importlib
-
-    try:
-        return importlib.import_module(module)
-    except ImportError:
-        raise ImportError(f"{what} needs the package '{module.split('.')[0]}': {EXTRA}") from None
-
-
-def _one_line(e: BaseException) -> str:
-    text = " ".join(str(e).split())
-    return f"{type(e).__name__}: {text}" if text else type(e).__name__
-
-
-def _call(fn, item, shared):
-    try:
-        return fn(item, shared)
-    except Exception as e:  # noqa: BLE001 - reported in the item's row, the batch goes on
-        return Failure(_one_line(e), traceback.format_exc())
-
-
-_limited_at = [-1]   # len(sys.modules) when one_blas_thread last set the limits in this process
-
-
-def one_blas_thread():
-    """Limit the BLAS libraries loaded in this process to one thread; returns the function that
-    restores the previous limits (a no-op without threadpoolctl).
-
-    threadpoolctl scans the loaded libraries on every call (0.7 ms; once per chunk, 3-4 % of a
-    short chunk's time), so a call made while the last limits hold (not restored) and no module
-    was imported since, hence no BLAS library loaded, returns at once."""
-    if len(sys.modules) == _limited_at[0]:
-        return lambda: None
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return lambda: None
-    restore = threadpool_limits(limits=1, user_api="blas").restore_original_limits
-    _limited_at[0] = len(sys.modules)
-
-    def restore_and_forget():
-        _limited_at[0] = -1
-        restore()
-    return restore_and_forget
 
 
 def run_chunk(items: Sequence, fn: Callable, shared: Any) -> list:

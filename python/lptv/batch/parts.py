@@ -42,7 +42,7 @@ class CheckpointError(ValueError):
 
 def encode(x):
     """Plain JSON values from results: arrays, tuples, complex numbers and Failures tagged."""
-    from .executors import Failure
+    from .common import Failure
 
     if isinstance(x, Failure):
         return {"__failure__": [x.message, x.detail]}
@@ -73,7 +73,7 @@ def encode(x):
 
 def decode(x):
     """The inverse of :func:`encode`."""
-    from .executors import Failure
+    from .common import Failure
 
     if isinstance(x, list):
         return [decode(v) for v in x]

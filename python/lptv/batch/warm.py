@@ -58,7 +58,7 @@ def warm_up():
             importlib.import_module(name)
         except ImportError:   # pragma: no cover - the first task reports it in its rows
             pass
-    from .executors import one_blas_thread
+    from .common import one_blas_thread
 
     one_blas_thread()
 

@@ -1,0 +1,56 @@
+"""The package's shape (DESIGN.md): no module imports another that imports it back, at any level
+(a lazy import inside a function counts: it is a circle all the same)."""
+import ast
+from pathlib import Path
+
+import lptv
+
+PACKAGE = Path(lptv.__file__).resolve().parent
+
+
+def _modules():
+    mods = {}
+    for p in PACKAGE.rglob("*.py"):
+        parts = p.relative_to(PACKAGE.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        mods[name] = p
+    return mods
+
+
+def _imports(name, path, mods):
+    """The package's modules that ``name`` imports (``from . import x`` names the module x)."""
+    pkg = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                up = pkg.split(".")[:len(pkg.split(".")) - (node.level - 1)]
+                base = ".".join(up + ([node.module] if node.module else []))
+            if node.module:
+                out.add(base)
+            out |= {f"{base}.{a.name}" for a in node.names}
+    return {m for m in out if m in mods and m != name}
+
+
+def test_the_checker_sees_a_circle(tmp_path):
+    """The check itself on a made-up package: a <-> b through a lazy import is found."""
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from .b import f\n")
+    (pkg / "b.py").write_text("def f():\n    from . import a\n")
+    mods = {"pkg": pkg / "__init__.py", "pkg.a": pkg / "a.py", "pkg.b": pkg / "b.py"}
+    assert _imports("pkg.a", mods["pkg.a"], mods) == {"pkg.b"}
+    assert _imports("pkg.b", mods["pkg.b"], mods) == {"pkg.a"}
+
+
+def test_no_module_imports_one_that_imports_it_back():
+    mods = _modules()
+    assert len(mods) > 40
+    edges = {m: _imports(m, p, mods) for m, p in mods.items()}
+    circles = sorted({tuple(sorted((a, b))) for a in edges for b in edges[a] if a in edges[b]})
+    assert not circles, circles
+
