@@ -27,4 +27,5 @@ PYBIND11_MODULE(_core, m) {
   bind_moderation(m);
   bind_record(m);
   bind_floquet(m);
+  bind_mimo(m);
 }

@@ -23,3 +23,4 @@ void bind_distortion(py::module_& m);
 void bind_moderation(py::module_& m);
 void bind_record(py::module_& m);
 void bind_floquet(py::module_& m);
+void bind_mimo(py::module_& m);

@@ -12,6 +12,7 @@ from ._validate import as_bool, as_int, as_positive_float, as_spectrum, as_str
 
 SOLVERS = ("auto", "band", "klu", "umfpack")
 from .floquet import UnstableModelWarning, unstable_warning_text
+from .mimo import MimoModel
 from .model import Model
 
 
@@ -73,11 +74,15 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
 
     Parameters
     ----------
-    model : lptv.Model
+    model : lptv.Model or lptv.MimoModel
     U : array_like, shape (L+1,) or (L+1, n_inputs)
         One-sided Fourier coefficients on lines 0..L: ``U[l] = fft(u)[l] / N`` for N samples
         of one period, so a cosine of amplitude A and phase phi on line l has
         ``U[l] = A/2 exp(j phi)``. ``U[0]`` must be real. Several columns share one factorisation.
+        For an :class:`lptv.MimoModel` with nu inputs and ny outputs: shape (L+1, nu), giving
+        (lines, ny), or (L+1, nu, E) for E experiments sharing one factorisation, giving
+        (lines, ny, E) (METHOD.md section 18: the block band system, channel fastest); the
+        stability check is not made for it (no Floquet analysis of matrix models yet).
     lines_out : int, optional
         Highest output line to return (default L).
     guard : int, optional
@@ -127,6 +132,11 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     >>> np.round(lptv.simulate(m, U)[1], 6)                    # 0.5 / (1j + 1)
     np.complex128(0.25-0.25j)
     """
+    if isinstance(model, MimoModel):
+        from .mimo_fds import simulate_mimo
+
+        return simulate_mimo(model, U, lines_out=lines_out, guard=guard, tol=tol, max_guard=max_guard,
+                             solver=solver, full_output=full_output)
     _check_model(model)
     Ua, was_1d = as_spectrum(U, "U")
     lines_out = -1 if lines_out is None else as_int(lines_out, "lines_out")
@@ -191,7 +201,13 @@ def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str
     Returns
     -------
     G : ndarray (grid size, len(lines)); row i is output line i - L (continuous) or i (discrete).
+        For an :class:`lptv.MimoModel`: (grid size, ny, len(lines), nu), G[i, p, j, r] the
+        output p on grid line i for a unit input r on lines[j] (METHOD.md eq. 18.5).
     """
+    if isinstance(model, MimoModel):
+        from .mimo_fds import htf_mimo
+
+        return htf_mimo(model, L, lines, solver)
     _check_model(model)
     # the core's largest grid (2^26 lines each side): checked here too, before the default list
     # of 2 L + 1 input lines below is built
@@ -212,7 +228,12 @@ def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str
 
 
 def band_matrices(model: Model, L: int = 0):
-    """The sparse band matrices (A, B) of METHOD.md eq. 5 as scipy.sparse CSC matrices."""
+    """The sparse band matrices (A, B) of METHOD.md eq. 5 as scipy.sparse CSC matrices (for an
+    :class:`lptv.MimoModel` the block band matrices of eq. 18.4, channel fastest)."""
+    if isinstance(model, MimoModel):
+        from .mimo_fds import band_matrices_mimo
+
+        return band_matrices_mimo(model, L)
     _check_model(model)
     L = as_int(L, "L")
     return _core.band_matrix(model._cpp, L, True), _core.band_matrix(model._cpp, L, False)

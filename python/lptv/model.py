@@ -277,7 +277,9 @@ class Model:
         """The model a :meth:`to_dict` description holds; every field is checked (its type, shape,
         finiteness, the format and version), and a wrong one is a ValueError naming it."""
         if not isinstance(d, dict) or d.get("format") != "lptv.Model":
-            raise ValueError("not an lptv.Model description (missing format: 'lptv.Model')")
+            hint = " (an lptv.MimoModel description: read it with lptv.MimoModel.load)" \
+                if isinstance(d, dict) and d.get("format") == "lptv.MimoModel" else ""
+            raise ValueError(f"not an lptv.Model description (missing format: 'lptv.Model'){hint}")
         unknown = [k for k in d if k not in _FIELDS]
         if unknown:
             raise ValueError(f"lptv.Model description: unknown field {unknown[0]!r} (fields: {', '.join(_FIELDS)})")

@@ -926,6 +926,63 @@ def python_cases():
         Case("plots.output_spectrum-w0-nan", "nan/inf", lambda: _plots().output_spectrum([1, 2], [1.0, 1.0], w0=NaN),
              match=names("w0")),
     ]
+
+    # several inputs and outputs: MimoModel, simulate on it, mimo_multisines
+    def mimo(a=None, b=None, w0=1.0, ts=None):
+        a = np.stack([np.diag([2.0, 3.0]), np.eye(2)]) if a is None else a
+        return lp().MimoModel(a, np.ones((1, 2, 1)) if b is None else b, w0=w0, ts=ts)
+
+    C += family("MimoModel", "w0", lambda v: mimo(w0=v), FLOAT_BAD)
+    C += [
+        Case("MimoModel-a-str", "type", lambda: mimo(a="abc"), match=names("a")),
+        Case("MimoModel-a-none", "type", lambda: lp().MimoModel(None, np.ones((1, 2, 1)), w0=1.0), match=names("a")),
+        Case("MimoModel-a-2d", "shape", lambda: mimo(a=np.ones((2, 2))), match=names("a")),
+        Case("MimoModel-a-not-square", "shape", lambda: mimo(a=np.ones((2, 2, 3, 1))), match=names("a")),
+        Case("MimoModel-a-nan", "nan/inf", lambda: mimo(a=np.full((2, 2, 2), NaN)), match=names("a")),
+        Case("MimoModel-a-even", "shape", lambda: mimo(a=np.ones((2, 2, 2, 2))), match=names("a")),
+        Case("MimoModel-a-empty", "size", lambda: mimo(a=np.ones((0, 2, 2, 1))), match=names("a")),
+        Case("MimoModel-b-none", "type", lambda: lp().MimoModel(np.ones((2, 2, 2)), None, w0=1.0), match=names("b")),
+        Case("MimoModel-b-rows", "shape", lambda: mimo(b=np.ones((1, 3, 1))), match=names("b")),
+        Case("MimoModel-b-inf", "nan/inf", lambda: mimo(b=np.full((1, 2, 1), INF)), match=names("b")),
+        Case("MimoModel-from_dict-not-dict", "type", lambda: lp().MimoModel.from_dict("abc"),
+             match=r"lptv\.MimoModel"),
+        Case("MimoModel-load-siso", "file", lambda: lp().MimoModel.load(model_json()), match=r"lptv\.Model\.load"),
+        Case("MimoModel-save-roundtrip", "value",
+             lambda: (mimo().save(folder() / "mimo.json"), lp().MimoModel.load(folder() / "mimo.json"))[1],
+             check=lambda m: m == mimo()),
+        Case("MimoModel-ts-zero-is-continuous", "value", lambda: mimo(ts=0), check=lambda m: m.ts is None),
+        Case("simulate-mimo-U-inputs", "shape", lambda: lp().simulate(mimo(), np.ones((4, 2))), match=names("U")),
+        Case("simulate-mimo-U-str", "type", lambda: lp().simulate(mimo(), "abc"), match=names("U")),
+        Case("simulate-mimo-U-nan", "nan/inf", lambda: lp().simulate(mimo(), np.full((4, 1), NaN)), match=names("U")),
+        Case("simulate-mimo-solver", "value", lambda: lp().simulate(mimo(), np.ones((4, 1)), solver="x"),
+             match=names("solver")),
+        Case("simulate-mimo-lti", "value", lambda: lp().simulate(mimo(), np.array([[0.0], [1.0]])),
+             check=lambda Y: np.allclose(Y[1], np.linalg.solve(np.diag([2.0, 3.0]) + 1j * np.eye(2), [1.0, 1.0]))),
+    ]
+    C += family("mimo_multisines", "n_inputs", lambda v: lp().mimo_multisines([1, 2], 16, v), INT_BAD)
+    C += family("mimo_multisines", "n_samples", lambda v: lp().mimo_multisines([1], v, 2), INT_BAD)
+    C += [
+        Case("mimo_multisines-design", "value", lambda: lp().mimo_multisines([1, 2], 16, 2, design="x"),
+             match=names("design")),
+        Case("mimo_multisines-n_experiments-few", "range",
+             lambda: lp().mimo_multisines([1, 2], 16, 2, n_experiments=1), match=names("n_experiments")),
+        Case("mimo_multisines-lines-repeated", "value", lambda: lp().mimo_multisines([2, 2], 16, 2), match=names("lines")),
+        Case("mimo_multisines-amplitudes-shape", "shape",
+             lambda: lp().mimo_multisines([1, 2], 16, 2, amplitudes=np.ones((3, 2))), match=names("amplitudes")),
+        Case("mimo_multisines-dc-complex-pattern", "value", lambda: lp().mimo_multisines([0, 2], 16, 3),
+             match=r"DC and the Nyquist line"),
+        Case("mimo_htf_estimate-u-3d", "shape", lambda: lp().mimo_htf_estimate(np.ones((2, 4, 2)), np.ones((2, 4, 2)),
+                                                                              [1], 0), match=names("u")),
+        Case("mimo_htf_estimate-y-nan", "nan/inf",
+             lambda: lp().mimo_htf_estimate(np.ones((2, 2, 8, 2)), np.full((2, 2, 8, 1), NaN), [1], 0), match=names("y")),
+        Case("mimo_htf_estimate-lines-close", "value",
+             lambda: lp().mimo_htf_estimate(np.ones((2, 2, 16, 2)), np.ones((2, 2, 16, 1)), [2, 3], 1),
+             match=names("lines")),
+        Case("mimo_htf_estimate-K-negative", "range",
+             lambda: lp().mimo_htf_estimate(np.ones((2, 2, 16, 2)), np.ones((2, 2, 16, 1)), [2], -1), match=names("K")),
+        Case("mimo_multisines-input_matrix-line", "range",
+             lambda: lp().mimo_multisines([1, 2], 16, 2, seed=0).input_matrix(9), match=names("line")),
+    ]
     return C
 
 
