@@ -1,4 +1,4 @@
-// The block band FDS of a matrix LPTV model (METHOD.md section 19, eqs. 18.3-18.5): AA Y = BB U on
+// The block band FDS of a matrix LPTV model (METHOD.md section 19, eqs. 19.3-19.5): AA Y = BB U on
 // the grid's lines, channel fastest, so AA is a scalar band matrix with ny (Ka + 1) - 1 sub- and
 // super-diagonals (continuous time) or a band wrapping around the corners (discrete time).
 #include <algorithm>
