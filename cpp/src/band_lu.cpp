@@ -129,7 +129,7 @@ Eigen::MatrixXcd SmallBandLU::solve(const Eigen::MatrixXcd& rhs) const {
     }
   };
   // Two threads when there are at least two blocks and enough work to pay for a thread
-  // (bench/RESULTS.md, the many-inputs section).
+  // (bench/HISTORY.md, the many-inputs section).
   if (nblocks >= 2 && static_cast<double>(n) * static_cast<double>(ncol) >= 2e5 &&
       std::thread::hardware_concurrency() >= 2) {
     const Eigen::Index mid = nblocks / 2;

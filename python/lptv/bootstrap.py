@@ -4,7 +4,7 @@ METHOD.md section 10).
 The analytic covariance of WGTLS and SML is a sandwich (an inverse information) times a
 small-sample factor (P-1)/(P-3) that the theory gives for rows whose weights have 2(P-1)
 degrees of freedom; at P = 4 that factor is 3 and the reported variance is 1.2-1.9 times the
-Monte Carlo variance on three systems (bench/RESULTS.md): the variance of the estimate is then
+Monte Carlo variance on three systems (bench/HISTORY.md): the variance of the estimate is then
 dominated by the randomness of the weights, which a factor cannot follow from one system to
 the next. The bootstrap follows it by doing what the data did: B data sets are drawn from the
 fitted model and the measured noise (co)variances, each of P periods per line (complex

@@ -247,7 +247,7 @@ class DistortionResult:
         (:meth:`input_level`, METHOD.md section 16). Measured on two Hammerstein systems: the
         output-referred fit was 1.5 std off the exact BLA (the paper's model), the
         input-referred one 0.1 std, with 2.7-2.9 times smaller spread; on Wiener systems (the
-        nonlinearity after the dynamics) the output-referred fit is the better one (bench/RESULTS.md).
+        nonlinearity after the dynamics) the output-referred fit is the better one (bench/HISTORY.md).
         The first fit may be of these experiments, or, where one common level on the outputs
         swamps a weak realisation (a strongly time-varying system whose output power depends on
         the phases; :func:`lptv.identify` then refuses it and says so), of the realisations with
@@ -269,7 +269,7 @@ class DistortionResult:
         where the distortion dominates the noise (the weights then ignore it), and there its
         intervals need not be right: measured, they covered the exact BLA 94.7 % of the time on
         the discrete-time example and 95.0 % on the third-order one, but 89.0 % on the paper's
-        model at P = 4 (bench/RESULTS.md). Its analytic
+        model at P = 4 (bench/HISTORY.md). Its analytic
         covariance would be the noise's alone, so :func:`lptv.identify` warns when it is asked for
         one and the distortion is detected.
 
@@ -593,7 +593,7 @@ def _default_branches(src, lines, spacing, M):
     denominator reach the neighbouring excited lines, and a branch left out of the regression
     would count as nonlinear distortion. (Capped at 4 spacings before: the discrete-time
     example, whose branches reach beyond +-23 near DC, was then "detected" in 40 % of purely
-    LPTV data sets at M = 16, with Kh = 23; bench/RESULTS.md.)"""
+    LPTV data sets at M = 16, with Kh = 23; bench/HISTORY.md.)"""
     best = max(spacing - 1, 0)
     if M - 2 >= src.size:                       # every excited line fits on every output line
         return int(lines.size)

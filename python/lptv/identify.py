@@ -134,7 +134,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         'bootstrap': the covariance of ``bootstrap`` refits of data sets drawn from the fitted
         model and the measured noise (co)variances, P periods each (`lptv.bootstrap`), which
         follows the randomness of the noise weights at small P where the factor does not
-        (bench/RESULTS.md, "Coverage on three systems"); one data set only, about ``bootstrap``
+        (bench/HISTORY.md, "Coverage on three systems"); one data set only, about ``bootstrap``
         times the cost of the fit.
         'realisations': several experiments that are independent random-phase realisations of
         one excitation (:meth:`lptv.DistortionResult.experiments`, E >= 4 of them): the
@@ -144,7 +144,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         'none': no covariance (``res.covariance`` None, ``confidence_interval`` refuses): the
         estimate, its residues and the verdict alone, for many fits whose intervals are not read
         (a structure search, a Monte Carlo of the estimates); the analytic covariance takes about
-        40 % of a WGTLS fit's time on the paper's example (bench/RESULTS.md).
+        40 % of a WGTLS fit's time on the paper's example (bench/HISTORY.md).
     bootstrap : int
         The number of refits for ``covariance='bootstrap'`` (at least 20).
     seed : int, optional
@@ -156,7 +156,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         1 + nu / 2 periods (nu the lines' median degrees of freedom, often 40-60 at P = 4 when
         the noise spectrum is smooth); the covariance's small-sample factor is taken at those
         periods. At P = 4-8 it lowers the variance of SML's estimate by 10-30 % and calibrates
-        its analytic intervals (bench/RESULTS.md, "Fits weighed by moderated noise"); it
+        its analytic intervals (bench/HISTORY.md, "Fits weighed by moderated noise"); it
         assumes a noise spectrum that is smooth over a few lines (lines far above their
         neighbours keep their own variance). Not with ``covariance='bootstrap'``. ``res.data``
         holds the moderated data the fit used.

@@ -125,7 +125,7 @@ class IdentificationResult:
         """Two-sided intervals ``eta +- z std`` for each entry of ``eta``: array (n_eta, 2).
 
         ``z`` is the normal quantile of ``level``; the covariance is the calibrated one (the Monte
-        Carlo in bench/RESULTS.md shows their coverage). The normalised parameter has a zero-width
+        Carlo in bench/HISTORY.md shows their coverage). The normalised parameter has a zero-width
         interval.
 
         Examples
@@ -319,7 +319,7 @@ class IdentificationResult:
         verdict then rests on it instead of :attr:`residue_tests`, whose reference (residues
         independent across lines, with the variances the data carry) the nonlinear distortion
         does not meet: on a Hammerstein system whose best linear approximation has the fitted
-        structure those tests rejected every fit (bench/RESULTS.md). None for other data."""
+        structure those tests rejected every fit (bench/HISTORY.md). None for other data."""
         exps = self.experiments
         d = exps[0].distortion if exps else None
         if d is None or len(exps) != d.realisations or any(

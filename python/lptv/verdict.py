@@ -226,7 +226,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     # WGTLS W = diag(1 / S_ii), SML W = S_fit^-1 (its full residue covariance, from the
     # variances it weighed by). (choice, SML) With the WGTLS projection instead, SML's residue
     # groups' normal scores sat at +0.05..+0.11 on 6000 null fits of three systems (WGTLS's on
-    # the same data -0.03..+0.02); with its own weights -0.04..+0.02 (bench/RESULTS.md, "The
+    # the same data -0.03..+0.02); with its own weights -0.04..+0.02 (bench/HISTORY.md, "The
     # verdict's size and power on bench_verdict's table"); with the sample S in both places
     # (MODERATE off) -0.07..-0.02 (WGTLS -0.05..-0.01). An earlier form of this verdict had
     # found that own projection over-subtracting at P = 4 (mean -0.33 on the discrete-time

@@ -53,14 +53,14 @@ from .common import EXTRA, Failure, _call, _one_line, one_blas_thread, require  
 from .warm import discard_pool, kept_pool, malloc_kept
 
 # Largest chunk: 32 fits of ~12 ms are ~0.4 s, against ~1-3 ms of per-task overhead on Dask
-# (bench/RESULTS.md), while leaving several chunks per worker for balance and for the ETA.
+# (bench/HISTORY.md), while leaving several chunks per worker for balance and for the ETA.
 MAX_CHUNK = 32
 CHUNKS_PER_WORKER = 4
 # Once the cost of an item is known (measured by the workers on an earlier call of the same
 # function in this process), a task lasts TASK_MIN..TASK_MAX seconds: about ten times the
 # per-task overhead of a process pool (about 1 ms; TASK_MIN_DASK for Dask's 3-4 ms), at most
 # what a progress bar and a checkpoint should wait for. The first round of tasks holds
-# FIRST_SHARE of the items (bench/RESULTS.md, "Chunks in rounds").
+# FIRST_SHARE of the items (bench/HISTORY.md, "Chunks in rounds").
 TASK_MIN, TASK_MIN_DASK, TASK_MAX = 0.01, 0.04, 0.4
 FIRST_SHARE = 0.75
 

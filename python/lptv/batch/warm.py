@@ -18,7 +18,7 @@ second and later calls:
 - :func:`malloc_kept`: Dask's nannies start their workers with ``MALLOC_TRIM_THRESHOLD_=65536``
   (so that glibc hands freed memory back to the system at once); glibc then keeps its mmap
   threshold at 128 KB, and every array of a fit above that (the periods, their spectra) is
-  mapped and unmapped anew: about 1300 page faults and 25 % more CPU per fit (bench/RESULTS.md).
+  mapped and unmapped anew: about 1300 page faults and 25 % more CPU per fit (bench/HISTORY.md).
   Around one of lptv's chunks the thresholds are raised as glibc's own dynamic rule would
   (mmap threshold 32 MB, trim threshold twice that), and afterwards they are put back and the
   free memory handed back with ``malloc_trim(0)``: the worker holds no more memory between
