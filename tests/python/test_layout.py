@@ -54,3 +54,26 @@ def test_no_module_imports_one_that_imports_it_back():
     circles = sorted({tuple(sorted((a, b))) for a in edges for b in edges[a] if a in edges[b]})
     assert not circles, circles
 
+
+
+# What the documents cite lives in the repository: a paper or a lecture by its authors and title,
+# never by a file outside it.
+OUTSIDE = ("seeds/", "../shared", "shared/seeds", "REFERENCES.md")
+
+
+def _documents(root):
+    docs = root / "docs"
+    files = [root / "README.md", root / "METHOD.md", root / "DESIGN.md", root / "bench" / "RESULTS.md",
+             root / "bench" / "HISTORY.md"]
+    files += [p for ext in ("md", "rst") for p in docs.rglob(f"*.{ext}")
+              if "auto_examples" not in p.relative_to(docs).parts]
+    return files + sorted((docs / "examples").glob("*.py"))
+
+
+def test_the_documents_name_no_file_outside_the_repository():
+    root = Path(__file__).resolve().parents[2]
+    files = _documents(root)
+    assert len(files) > 20 and all(p.exists() for p in files[:5])
+    found = [f"{p.relative_to(root)}:{i}: {line.strip()}" for p in files
+             for i, line in enumerate(p.read_text().splitlines(), 1) if any(s in line for s in OUTSIDE)]
+    assert not found, "\n".join(found)
