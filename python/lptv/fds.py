@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
 from typing import Optional, Sequence
 
 import numpy as np
@@ -10,50 +9,11 @@ import numpy as np
 from . import _core
 from ._validate import as_bool, as_int, as_positive_float, as_spectrum, as_str
 
-SOLVERS = ("auto", "band", "klu", "umfpack")
+from .fds_types import (CONDITION_MAX, CONDITION_WARN, MAX_GRID_LINES, SOLVERS,  # noqa: F401 - lptv.fds.*
+                        ConditioningWarning, SimulationResult, TruncationWarning)
 from .floquet import UnstableModelWarning, unstable_warning_text
 from .mimo import MimoModel
 from .model import Model
-
-
-class TruncationWarning(UserWarning):
-    """The adaptive guard did not bring the truncation error below the tolerance."""
-
-
-class ConditioningWarning(UserWarning):
-    """The band system is nearly singular next to a line that carries output: a pole within a
-    relative distance of about 1 / condition of the line (a nearly undamped resonance). The
-    output there is amplified about ``condition`` times and is as sensitive to the
-    coefficients; more than half of the 16 digits are lost."""
-
-
-CONDITION_WARN = float(_core.FDS_WARN_CONDITION)
-"""Condition number (relative to the coefficients on the line) above which :func:`simulate`
-warns (1e8: more than half the digits lost, 1 / sqrt(eps) = 6.7e7 rounded up)."""
-CONDITION_MAX = float(_core.FDS_MAX_CONDITION)
-"""Above this :func:`simulate` refuses with :class:`lptv.NumericalError` (1e13: fewer than 3 digits)."""
-
-
-@dataclass(frozen=True)
-class SimulationResult:
-    """Output of :func:`simulate` with ``full_output=True``."""
-
-    Y: np.ndarray
-    """One-sided output spectra on lines 0..lines_out."""
-    guard: int
-    """Guard lines used beyond the band (continuous time)."""
-    truncation_error: float
-    """Estimated error from dropping lines beyond the grid, relative to the largest output line."""
-    converged: bool
-    """Whether the truncation error met ``tol``."""
-    solver: str
-    """Factorisation used ('band', 'klu' or 'umfpack')."""
-    condition: float = float("nan")
-    """Componentwise condition number of the band system relative to the model's coefficients
-    (max over the lines of sum |terms| / |result|; an LTI model: over the lines with input), a
-    lower estimate: about log10(condition) of the 16 digits are lost."""
-    condition_line: int = 0
-    """The line where ``condition`` peaks."""
 
 
 def _check_model(model, name="model"):
@@ -183,7 +143,6 @@ def _warn_unstable(model: Model) -> None:
         warnings.warn(text, UnstableModelWarning, stacklevel=3)
 
 
-MAX_GRID_LINES = 2 ** 26
 
 
 def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str = "auto"):
@@ -229,7 +188,7 @@ def htf(model: Model, L: int, lines: Optional[Sequence[int]] = None, solver: str
 
 def band_matrices(model: Model, L: int = 0):
     """The sparse band matrices (A, B) of METHOD.md eq. 5 as scipy.sparse CSC matrices (for an
-    :class:`lptv.MimoModel` the block band matrices of eq. 18.4, channel fastest)."""
+    :class:`lptv.MimoModel` the block band matrices of eq. 19.4, channel fastest)."""
     if isinstance(model, MimoModel):
         from .mimo_fds import band_matrices_mimo
 

@@ -42,7 +42,7 @@ def _outputs(Y, ny, E, kind):
 
 def simulate_mimo(model: MimoModel, U, *, lines_out, guard, tol, max_guard, solver, full_output):
     """lptv.simulate for a MimoModel (its arguments checked and documented there)."""
-    from .fds import CONDITION_WARN, ConditioningWarning, SimulationResult, TruncationWarning
+    from .fds_types import CONDITION_WARN, ConditioningWarning, SimulationResult, TruncationWarning
 
     cols, E, kind = as_mimo_spectrum(U, model.n_inputs)
     lines_out = -1 if lines_out is None else as_int(lines_out, "lines_out")
@@ -74,7 +74,7 @@ def simulate_mimo(model: MimoModel, U, *, lines_out, guard, tol, max_guard, solv
 
 def htf_mimo(model: MimoModel, L: int, lines, solver: str) -> np.ndarray:
     """lptv.htf for a MimoModel: G of shape (grid lines, ny, len(lines), nu)."""
-    from .fds import MAX_GRID_LINES
+    from .fds_types import MAX_GRID_LINES
 
     L = as_int(L, "L", maximum=MAX_GRID_LINES)
     solver = as_str(solver, "solver", _SOLVERS)
