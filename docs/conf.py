@@ -1,8 +1,9 @@
 """Sphinx configuration of the lptv documentation (make docs builds it into build/docs/html).
 
-The pages: the README (its links pointed at the pages here), the API reference from the
-numpydoc docstrings of the installed package, a gallery of examples that sphinx-gallery runs
-on every build (an error in one fails the build), METHOD.md, DESIGN.md and bench/RESULTS.md.
+The pages: the README (its links pointed at the pages here), the user guide (docs/guide), the API
+reference from the numpydoc docstrings of the installed package, a gallery of examples that
+sphinx-gallery runs on every build (an error in one fails the build), METHOD.md, DESIGN.md,
+bench/RESULTS.md and bench/HISTORY.md.
 """
 import os
 import re
@@ -69,9 +70,14 @@ sphinx_gallery_conf = {
 
 # The Markdown files of the source tree, read into the pages of the same name (each page in
 # docs/ is a stub): README.md with its links to the source tree turned into the site's pages.
+# The user guide (docs/guide/*.md) is read where it is; its links into the source tree
+# (../../METHOD.md) and to the gallery's scripts (../examples/plot_*.py) turn into the site's pages.
 _PAGES = {"readme": "README.md", "method": "METHOD.md", "design": "DESIGN.md",
-          "results": "bench/RESULTS.md"}
-_LINKS = {"bench/RESULTS.md": "results.md", "DESIGN.md": "design.md", "METHOD.md": "method.md"}
+          "results": "bench/RESULTS.md", "history": "bench/HISTORY.md"}
+_LINKS = {"bench/RESULTS.md": "results.md", "bench/HISTORY.md": "history.md", "DESIGN.md": "design.md",
+          "METHOD.md": "method.md", "README.md": "readme.md"}
+_BENCH_LINKS = {"RESULTS.md": "results.md", "HISTORY.md": "history.md"}
+_GALLERY_LINK = re.compile(r"\]\(\.\./examples/(plot_\w+)\.py\)")
 _CODE_SPAN = re.compile(r"(`+)(?:(?!\n[ \t]*\n)[\s\S])*?\1")   # may span lines, not paragraphs
 _WORD_STAR = re.compile(r"(?<=[A-Za-z0-9])\*(?=[A-Za-z0-9])")
 
@@ -113,6 +119,12 @@ def _escape(s):
 
 
 def _markdown_page(app, docname, source):
+    if docname.startswith("guide/"):
+        text = source[0]
+        for old, new in _LINKS.items():
+            text = text.replace(f"](../../{old})", f"](../{new})")
+        source[0] = _plain_maths(_GALLERY_LINK.sub(r"](../auto_examples/\1.rst)", text))
+        return
     if docname not in _PAGES:
         return
     text = (ROOT / _PAGES[docname]).read_text()
@@ -120,6 +132,9 @@ def _markdown_page(app, docname, source):
         for old, new in _LINKS.items():
             text = text.replace(f"]({old})", f"]({new})")
         text = text.replace("](docs/", "](")
+    if docname in ("results", "history"):
+        for old, new in _BENCH_LINKS.items():
+            text = text.replace(f"]({old})", f"]({new})")
     source[0] = _plain_maths(text)
 
 

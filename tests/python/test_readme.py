@@ -1,26 +1,55 @@
-"""The README's Python example runs as printed."""
+"""The Python examples of the README and of the user guide (docs/guide/*.md) run as printed."""
 import re
 from pathlib import Path
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+ROOT = Path(__file__).resolve().parents[2]
+README = ROOT / "README.md"
+DOCS = [README] + sorted((ROOT / "docs" / "guide").glob("*.md"))
+
+# One marker per Python block of the README and the guide: the test that runs it finds it by this.
+MARKERS = ("lptv.frozen_poles(res.model", "lptv.inspect(", "lptv.read_measurements(", "lptv.montecarlo(",
+           "records.append(", "lptv.plots.distortion(d)", "lptv.min_crest_multisine(", "transient_record(",
+           "continuous=True", 'referred="input"', 'referred="none"', 'disturbances="remove"',
+           "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", 'noise="moderated"')
 
 
-def run_block(marker, tmp_path, monkeypatch):
-    """Runs the one Python block of the README that contains ``marker``, in tmp_path; its names."""
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S) if marker in b]
-    assert len(blocks) == 1
+def all_text():
+    return "\n".join(p.read_text() for p in DOCS)
+
+
+def python_blocks():
+    """(file name, block) of every Python block of the README and the guide."""
+    return [(p.name, b) for p in DOCS for b in re.findall(r"```python\n(.*?)```", p.read_text(), flags=re.S)]
+
+
+def find_block(marker):
+    blocks = [(name, b) for name, b in python_blocks() if marker in b]
+    assert len(blocks) == 1, f"{marker!r} is in {len(blocks)} blocks of the README and the guide"
+    return blocks[0]
+
+
+def run_block(marker, tmp_path, monkeypatch, ns=None):
+    """Runs the one Python block of the README or the guide that contains ``marker``, in
+    tmp_path (in the names ``ns`` when given); its names."""
+    name, block = find_block(marker)
     monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = {} if ns is None else ns
+    exec(compile(block, name, "exec"), ns)
     return ns
 
 
+def test_every_block_is_run_by_its_marker():
+    """Each Python block of the README and the guide holds exactly one of the markers, and each
+    marker is in exactly one block: a new block needs its test."""
+    for name, block in python_blocks():
+        held = [m for m in MARKERS if m in block]
+        assert len(held) == 1, f"a block of {name} holds the markers {held}:\n{block[:300]}"
+    for m in MARKERS:
+        find_block(m)
+
+
 def test_readme_python_example_runs(tmp_path, monkeypatch):
-    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-    assert blocks, "README has no Python example"
-    monkeypatch.chdir(tmp_path)
-    ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    ns = run_block("lptv.frozen_poles(res.model", tmp_path, monkeypatch)
     res, err, Y = ns["res"], ns["err"], ns["Y"]
     assert res.converged and res.residue_ok
     assert ns["poles"].shape == (100, 2)
@@ -73,7 +102,7 @@ def test_readme_real_rig_example_runs(tmp_path, monkeypatch):
 
     from lptv.apps import cli
 
-    cmd = re.search(r"```sh\n(lptv identify rig\.npz[^\n]*)\n```", README.read_text()).group(1)
+    cmd = re.search(r"```sh\n(lptv identify rig\.npz[^\n]*)\n```", all_text()).group(1)
     assert cli.main(shlex.split(cmd)[1:]) == 0
     s = json.loads((tmp_path / "rig-lptv" / "summary.json").read_text())
     assert s["realisations"] == 6 and s["distortion"]["detected"] and (tmp_path / "rig-lptv" / "distortion.png").exists()
@@ -111,9 +140,7 @@ def test_readme_continuous_record_example_runs(tmp_path, monkeypatch):
 def test_readme_input_referred_example_runs(tmp_path, monkeypatch):
     """The block that refers an actuator's distortion to the input continues the rig's block."""
     ns = run_block("lptv.plots.distortion(d)", tmp_path, monkeypatch)
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S) if 'referred="input"' in b]
-    assert len(blocks) == 1
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    run_block('referred="input"', tmp_path, monkeypatch, ns)
     lof = ns["bla_in"].lack_of_fit
     assert lof is not None and lof.realisations == 6 and ns["bla_in"].covariance is not None
 
@@ -122,7 +149,7 @@ def test_readme_noise_alone_example_runs(tmp_path, monkeypatch):
     """The strongly time-varying system's BLA: the realisations with their noise alone and the
     jackknife. Every parameter within its 99.9 % interval of the exact BLA (the reported std is
     scaled so that +-1.96 std is the t interval of its degrees of freedom, about 1 here: one
-    realisation carries most of the information; its calibration is bench/RESULTS.md's), and the
+    realisation carries most of the information; its calibration is bench/HISTORY.md's), and the
     lack of fit keeps it."""
     import numpy as np
 
@@ -182,3 +209,61 @@ def test_readme_inspect_example_runs(tmp_path, monkeypatch, capsys):
         err = capsys.readouterr().err
         start = flat.index(quoted)
         assert flat[start:flat.index("`", start)] in err
+
+
+def test_readme_quick_start_identify_runs(tmp_path, monkeypatch, capsys):
+    """The quick start's two commands on the record the README makes: one order too few is
+    rejected (exit status 3), the right orders are consistent (0), with the verdicts it quotes;
+    the Python equivalent gives the same verdict."""
+    import shlex
+
+    from lptv.apps import cli
+
+    ns = run_block("lptv.inspect(", tmp_path, monkeypatch)
+    capsys.readouterr()
+    text = README.read_text()
+    flat = " ".join(text.split())
+    cmds = re.search(r"```sh\n(lptv identify rig\.csv[^\n]*)\n(lptv identify rig\.csv[^\n]*)\n```", text).groups()
+    codes, outs = [], []
+    for cmd in cmds:
+        codes.append(cli.main(shlex.split(cmd)[1:]))
+        outs.append(" ".join(capsys.readouterr().out.split()))
+    assert codes == [3, 0]
+    for out, quoted in zip(outs, ("verdict: MODEL ERRORS: the model is rejected: the normalised residues on the 20 rows with signal are too large",
+                                  "verdict: the model is consistent with the noise")):
+        assert quoted in flat and quoted in out
+    assert (tmp_path / "rig-lptv" / "report.html").exists()
+    res = run_block("lptv.read_measurements(", tmp_path, monkeypatch, ns)["res"]
+    assert res.model_ok and res.verdict.startswith("the model is consistent with the noise")
+
+
+def test_guide_disturbances_example_runs(tmp_path, monkeypatch, capsys):
+    """The hum off the period's grid: the verdict finds the residues too small, the hum is found
+    at the line the comment says, and removing it gives a consistent model."""
+    run_block('disturbances="remove"', tmp_path, monkeypatch)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("MODEL ERRORS") and "too small" in out[0]
+    assert "a sinusoid at line 85.370" in "\n".join(out[1:-1])
+    assert "consistent" in out[-1] and not out[-1].startswith("MODEL ERRORS")
+
+
+def test_guide_mimo_example_runs(tmp_path, monkeypatch):
+    """Two masses with a periodic coupling: the HTF matrices from two orthogonal experiments
+    against the model's, within the noise and their reported variance."""
+    import numpy as np
+
+    ns = run_block("lptv.mimo_htf_estimate(", tmp_path, monkeypatch)
+    est, G0 = ns["est"], ns["G0"]
+    assert est.G.shape == (10, 3, 2, 2)
+    assert np.abs(est.G[:, 1] - G0).max() < 0.05 * np.abs(G0).max()
+    z = np.abs(est.G[:, 1] - G0) / np.sqrt(est.variance[:, 1])
+    assert z.max() < 6
+
+
+def test_guide_identify_example_runs(tmp_path, monkeypatch):
+    """Four periods of the paper's example, weighed by moderated noise variances: consistent,
+    every parameter with its std; the fit without a covariance has none."""
+    ns = run_block('noise="moderated"', tmp_path, monkeypatch)
+    res, quick = ns["res"], ns["quick"]
+    assert res.converged and res.model_ok and (res.parameter_std[res.parameter_std > 0]).size == 34
+    assert quick.converged and quick.covariance is None

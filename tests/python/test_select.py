@@ -187,10 +187,10 @@ def test_readme_select_example_runs():
     import re
     from pathlib import Path
 
-    readme = Path(__file__).resolve().parents[2] / "README.md"
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", readme.read_text(), flags=re.S)
-              if "lptv.select(" in b]
+    root = Path(__file__).resolve().parents[2]     # the README and the user guide (docs/guide)
+    text = "\n".join(p.read_text() for p in [root / "README.md", *sorted((root / "docs" / "guide").glob("*.md"))])
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if "lptv.select(" in b]
     assert len(blocks) == 1
     ns = {}
-    exec(compile(blocks[0], "README.md", "exec"), ns)
+    exec(compile(blocks[0], "06-structure.md", "exec"), ns)
     assert ns["sel"].choice == (2, 1, 3) and ns["sel"].result.method == "sml"
