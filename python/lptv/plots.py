@@ -12,12 +12,57 @@ from typing import Optional
 import numpy as np
 
 
+# Margins of a new figure in inches: room for the tick labels and the axis label on the left,
+# the x label below and a title above. Fixed margins instead of matplotlib's constrained layout,
+# which measures every text of every axes before drawing (it was half of the identify report's
+# figure time); every figure here keeps its texts within these margins.
+MARGINS = dict(left=0.85, right=0.2, bottom=0.55, top=0.42, hspace=0.55, wspace=0.75)
+
+
+def _figure(figsize=(6.4, 4.0), rows: int = 1, cols: int = 1, *, sharex=False, width_ratios=None,
+            height_ratios=None, **margins):
+    """A new figure (not through pyplot) and its ``rows`` x ``cols`` axes (a 2-D array), with the
+    fixed :data:`MARGINS` (in inches; keywords override them)."""
+    from matplotlib.figure import Figure
+
+    m = {**MARGINS, **margins}
+    w, h = figsize
+    fig = Figure(figsize=figsize)
+    # hspace / wspace are fractions of the mean axes' height / width
+    ax_h = (h - m["bottom"] - m["top"] - (rows - 1) * m["hspace"]) / rows
+    ax_w = (w - m["left"] - m["right"] - (cols - 1) * m["wspace"]) / cols
+    fig.subplots_adjust(left=m["left"] / w, right=1 - m["right"] / w, bottom=m["bottom"] / h,
+                        top=1 - m["top"] / h, hspace=m["hspace"] / max(ax_h, 0.1),
+                        wspace=m["wspace"] / max(ax_w, 0.1))
+    return fig, fig.subplots(rows, cols, sharex=sharex, squeeze=False, width_ratios=width_ratios,
+                             height_ratios=height_ratios)
+
+
 def _axes(ax, figsize=(6.4, 4.0)):
     if ax is not None:
         return ax
-    from matplotlib.figure import Figure
+    return _figure(figsize)[1][0, 0]
 
-    return Figure(figsize=figsize, layout="constrained").subplots()
+
+def _log_x(ax):
+    """A logarithmic frequency axis with ticks at 1, 2, 5 times the powers of ten, labelled in
+    plain numbers (0.5, 1, 2, 5, 10, ...) rather than in powers of ten, and no minor ticks (each
+    tick is a text to lay out and a grid line to draw)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
+
+    ax.set_xscale("log")
+    ax.xaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.grid(True, which="major", alpha=0.3)
+
+
+def _z_of(level: float) -> float:
+    """The two-sided standard normal quantile of a confidence level (the standard library's:
+    scipy.stats costs half a second to import)."""
+    from statistics import NormalDist
+
+    return NormalDist().inv_cdf(0.5 + level / 2.0)
 
 
 def _series(x, name, n=None, ndim=1):
@@ -375,8 +420,6 @@ def disturbances(result, *, w0: float = None, hz: bool = False, fig=None):
     >>> [ax.get_title() for ax in fig.axes]
     ['input: nothing found', 'output: 1 sinusoid off the grid']
     """
-    import matplotlib.pyplot as plt
-
     from .disturbances import DisturbanceResult
     from ._validate import as_bool, as_float
 
@@ -387,10 +430,13 @@ def disturbances(result, *, w0: float = None, hz: bool = False, fig=None):
         w0 = as_float(w0, "w0", minimum=0.0, open_min=True)
     if not result.spectra:
         raise ValueError("result holds no spectra: the records were too short to search")
+    n = len(result.spectra)
     if fig is None:
-        fig = plt.figure(figsize=(6.4, 2.6 * len(result.spectra)))
+        fig, axes = _figure((6.4, 2.6 * n), n, 1, hspace=0.85)
+    else:
+        axes = fig.subplots(n, 1, squeeze=False)
+    axes = axes[:, 0]
     names = {"u": "input", "y": "output"}
-    axes = fig.subplots(len(result.spectra), 1, squeeze=False)[:, 0]
     for ax, (sig, (pos, p2, level)) in zip(axes, result.spectra.items()):
         x, label = (pos, "line (cycles per period)") if w0 is None else _freq_axis(pos, w0, hz)
         ax.plot(x, 10 * np.log10(np.maximum(p2, 1e-300)), ".", ms=2, color="C0", alpha=0.5,
@@ -408,14 +454,21 @@ def disturbances(result, *, w0: float = None, hz: bool = False, fig=None):
         ax.set_ylabel("power (dB)")
         ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize="small", loc="upper right")
-    fig.tight_layout()
     return fig
 
 
-def residue_tests(res, *, ax=None):
-    """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`) as bars: each
-    test's statistic z (standard normal without a model error) with the level at which the
-    smallest p-value rejects under Holm's method (overall size 1 %); rejecting tests in red.
+def residue_tests(res, *, fig=None):
+    """The verdict's residue tests (:attr:`lptv.IdentificationResult.residue_tests`) as horizontal
+    bars, each on its own statistic against its own threshold, under the short names of
+    :func:`residue_test_label` (the reports' tables use them too): the sums of normal scores (z,
+    standard normal without a model error; two-sided over all rows with signal, one-sided per
+    group of rows at one distance d from the excited lines) in the upper panel, the score tests of
+    one more harmonic per coefficient (an F statistic with its own degrees of freedom) in the
+    lower one. A test's threshold is where its statistic reaches the level Holm's method gives
+    it, alpha / (number of tests not yet rejected before it) (overall size ``alpha``, 1 %); it
+    rejects (red) when it and every test with a smaller p-value reach theirs.
+
+    Returns the figure.
 
     Examples
     --------
@@ -423,31 +476,125 @@ def residue_tests(res, *, ax=None):
     >>> from lptv.examples import system_measurements
     >>> d = system_measurements("third_order", seed=1, periods=8)
     >>> res = lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], lines=d["lines"])
-    >>> ax = lptv.plots.residue_tests(res)
-    >>> [t.get_text().split()[0] for t in ax.get_xticklabels()][:2]
-    ['all', '|d|']
+    >>> fig = lptv.plots.residue_tests(res)
+    >>> [ax.get_xlabel().split(":")[0] for ax in fig.axes]
+    ['z', 'F of the score test for one more harmonic on the coefficient']
     """
-    from scipy import stats
-
     tests = getattr(res, "residue_tests", None)
     if tests is None:
         raise ValueError("res: the fit has no residue tests (no noise in the data, or no data kept)")
-    ax = _axes(ax)
-    names = [("all rows" if t.name == "rows with signal" else "|d| = " + t.name.split()[1]) + f"\n({t.rows.size})"
-             for t in tests.tests]
-    z = np.array([t.statistic for t in tests.tests])
-    colors = ["C3" if t.rejects else "C0" for t in tests.tests]
-    ax.bar(np.arange(z.size), z, color=colors)
-    k = z.size
-    ax.axhline(stats.norm.isf(tests.alpha / k), color="k", ls="--", lw=1,
-               label=f"Holm's first level ({100 * tests.alpha:g} % / {k}, one-sided)")
-    ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_xticks(np.arange(z.size), names, fontsize="small")
-    ax.set_ylabel("z (N(0, 1) without a model error)")
-    ax.set_xlabel("rows (count): all rows with signal; rows d lines from the nearest excited line")
-    ax.legend(fontsize="small")
-    ax.grid(True, axis="y", alpha=0.3)
-    return ax
+    thresholds = residue_test_thresholds(tests)
+    groups = [[i for i, t in enumerate(tests.tests) if t.kind != "score"],
+              [i for i, t in enumerate(tests.tests) if t.kind == "score"]]
+    groups = [g for g in groups if g]
+    # horizontal bars, one row per test: the names read in full and each threshold marks its own row
+    heights = [len(g) + 0.6 for g in groups]
+    if fig is None:
+        fig, axes = _figure((6.4, 1.35 + 0.3 * sum(heights) + 0.55 * (len(groups) - 1)), len(groups), 1,
+                            left=1.95, top=0.5, bottom=0.5, hspace=0.55, height_ratios=heights)
+    else:
+        axes = fig.subplots(len(groups), 1, squeeze=False, height_ratios=heights)
+    for ax, idx in zip(axes[:, 0], groups):
+        score = tests.tests[idx[0]].kind == "score"
+        y = np.arange(len(idx))[::-1]
+        stat = np.array([tests.tests[i].statistic for i in idx])
+        ax.barh(y, stat, height=0.6, color=["C3" if tests.tests[i].rejects else "C0" for i in idx])
+        for yi, i in zip(y, idx):
+            for thr in thresholds[i]:
+                if thr is not None:
+                    ax.vlines(thr, yi - 0.42, yi + 0.42, color="k", ls="--", lw=1.2)
+        ax.set_yticks(y, [f"{residue_test_label(tests.tests[i])} ({tests.tests[i].rows.size} rows)" for i in idx],
+                      fontsize="small")
+        ax.set_ylim(-0.6, len(idx) - 0.4)
+        marks = [v for i in idx for v in thresholds[i] if v is not None]
+        if score:
+            ax.set_xlabel("F of the score test for one more harmonic on the coefficient", fontsize="small")
+            top = max(float(np.max(stat)), max(marks))
+            if top > 30 * max(marks):      # a rejected structure's F of 10^5 would hide the thresholds
+                from matplotlib.ticker import FuncFormatter
+
+                ax.set_xscale("log")
+                ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+                ax.set_xlim(0.5 * min(float(np.min(stat[stat > 0], initial=1.0)), min(marks)), 2 * top)
+            else:
+                ax.set_xlim(0, 1.1 * top)
+        else:
+            ax.set_xlabel("z: sum of the rows' normal scores over its std (N(0, 1) without a model error)",
+                          fontsize="small")
+            lo = min(0.0, float(np.min(stat)), min(marks))
+            hi = max(0.0, float(np.max(stat)), max(marks))
+            pad = 0.08 * (hi - lo)
+            ax.set_xlim(lo - pad, hi + pad)
+            ax.axvline(0.0, color="k", lw=0.8)
+        ax.grid(True, axis="x", alpha=0.3)
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    fig.legend(handles=[Line2D([], [], color="k", ls="--", lw=1.1,
+                               label=f"each test's threshold (Holm, overall {100 * tests.alpha:g} %)"),
+                        Patch(color="C0", label="not rejected"), Patch(color="C3", label="rejects")],
+               loc="upper center", ncol=3, fontsize="small", frameon=False, borderaxespad=0.2)
+    return fig
+
+
+def residue_test_label(test) -> str:
+    """The short name of a residue test (a :class:`lptv.verdict.ResidueTest`) that the reports'
+    table and :func:`residue_tests` share: 'all rows' (every row with signal), 'd = 3' (the rows 3
+    lines from the nearest excited line), 'a0: +1 harmonic' (the score test of one more harmonic
+    on a_0)."""
+    import re
+
+    if test.kind == "score":
+        m = re.search(r"on (\w+)$", test.name)
+        return f"{m.group(1) if m else test.name}: +1 harmonic"
+    if test.name == "rows with signal":
+        return "all rows"
+    m = re.match(r"rows (\d+) lines? from", test.name)
+    return f"d = {m.group(1)}" if m else test.name
+
+
+def residue_test_thresholds(tests):
+    """Per test of a :class:`lptv.verdict.ResidueTests`, its thresholds ``(lower, upper)`` on its own
+    statistic (None where a side is not tested): the values at which its p-value reaches the level
+    Holm's step-down method gives it, alpha / (k - r) for the test of rank r (0 for the smallest
+    p-value) among k. A z test (a sum of normal scores): one-sided per offset group (upper), two-sided over all
+    rows with signal; a score test: the F(2, nu) quantile, nu recovered from the test's F value and
+    p-value (the F(2, nu) tail is (1 + 2 F / nu)^(-nu / 2), monotone in nu; nu infinite is the
+    chi-squared limit exp(-F))."""
+    from statistics import NormalDist
+
+    k = len(tests.tests)
+    ranks = np.argsort(np.argsort([t.p_value for t in tests.tests], kind="stable"), kind="stable")
+    out = []
+    for t, r in zip(tests.tests, ranks):
+        q = tests.alpha / (k - r)
+        if t.kind == "score":
+            nu = _f2_dof(t.statistic, t.p_value)
+            out.append((None, -np.log(q) if nu is None else nu / 2 * (q ** (-2 / nu) - 1)))
+        elif t.name == "rows with signal":
+            zq = NormalDist().inv_cdf(1 - q / 2)
+            out.append((-zq, zq))
+        else:
+            out.append((None, NormalDist().inv_cdf(1 - q)))
+    return out
+
+
+def _f2_dof(F: float, p: float):
+    """nu with P(F(2, nu) > F) = p; None for the chi-squared limit (p at or below exp(-F))."""
+    if not (F > 0 and 0 < p < 1) or np.log(p) <= -F * (1 - 1e-12):
+        return None
+    g = lambda nu: -nu / 2 * np.log1p(2 * F / nu) - np.log(p)     # decreasing in nu
+    lo, hi = 1e-6, 1.0
+    while g(hi) > 0:
+        hi *= 2
+        if hi > 1e12:
+            return None
+    for _ in range(200):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if g(mid) > 0 else (lo, mid)
+        if hi / lo < 1 + 1e-13:
+            break
+    return float(np.sqrt(lo * hi))
 
 
 def coefficients(t, true=None, est=None, *, names=None, ax=None, ylabel="coefficient value"):
@@ -481,6 +628,77 @@ def coefficients(t, true=None, est=None, *, names=None, ax=None, ylabel="coeffic
     if handles:
         ax.legend(handles=handles, fontsize="small", ncol=2 if n > 4 else 1)
     return ax
+
+
+def coefficient_bands(t, values, std=None, *, names, units=None, level: float = 0.95, fig=None,
+                      title: Optional[str] = None):
+    """One panel per coefficient over time (``values``, shape (len(t), n)), each on its own axis
+    with its ``level`` band ``+- z std`` (``std`` of the same shape, or None): coefficients of very
+    different sizes (a stiffness of 40 and a mass of 1) each show their own time variation.
+    ``units``: a unit per coefficient for its axis label (or None).
+
+    Returns the figure.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> t = np.linspace(0, 5, 50)
+    >>> v = np.column_stack([40 + 12 * np.cos(2 * np.pi * t / 5), np.full(50, 0.8)])
+    >>> fig = lptv.plots.coefficient_bands(t, v, 0.01 * np.ones((50, 2)), names=["a0", "a1"])
+    >>> [ax.get_ylabel() for ax in fig.axes]
+    ['a0', 'a1']
+    """
+    from ._validate import as_float
+
+    t = _series(t, "t")
+    values = _series(values, "values", t.size, ndim=2)
+    n = values.shape[1]
+    if std is not None:
+        std = _series(std, "std", t.size, ndim=2)
+        if std.shape != values.shape:
+            raise ValueError(f"std must have the shape of values {values.shape}, got {std.shape}")
+    names = [str(v) for v in names]
+    if len(names) != n:
+        raise ValueError(f"names must name each of the {n} coefficients, got {len(names)}")
+    units = [None] * n if units is None else list(units)
+    if len(units) != n:
+        raise ValueError(f"units must have one entry per coefficient ({n}), got {len(units)}")
+    level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
+    z = _z_of(level)
+    cols = 1 if n == 1 else 2
+    rows = -(-n // cols)
+    if fig is None:
+        fig, axes = _figure((6.4, 0.95 + 1.75 * rows), rows, cols, sharex=True, hspace=0.3, wspace=1.05)
+    else:
+        axes = fig.subplots(rows, cols, sharex=True, squeeze=False)
+    for j in range(rows * cols):
+        ax = axes.flat[j]
+        if j >= n:
+            ax.set_visible(False)
+            continue
+        color = f"C{j % 10}"
+        if std is not None:
+            ax.fill_between(t, values[:, j] - z * std[:, j], values[:, j] + z * std[:, j], color=color,
+                            alpha=0.25, lw=0)
+        ax.plot(t, values[:, j], "-", color=color, lw=1.4)
+        ax.set_ylabel(names[j] + (f" ({units[j]})" if units[j] else ""))
+        ax.grid(True, alpha=0.3)
+        # a constant coefficient: a few significant digits of range around it, not rounding noise
+        lo, hi = ax.get_ylim()
+        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        floor = 1e-3 * max(abs(mid), 1e-300)
+        if half < floor:
+            ax.set_ylim(mid - floor, mid + floor)
+        ax.ticklabel_format(axis="y", useOffset=False)
+    for ax in axes[-1]:
+        ax.set_xlabel("time (s)")
+    if rows > 1 and n % cols:     # the last row's empty slot: the x label on the panel above it
+        axes[-2, -1].xaxis.set_tick_params(labelbottom=True)
+        axes[-2, -1].set_xlabel("time (s)")
+    band = f" ({100 * level:g} % band)" if std is not None else ""
+    fig.suptitle((title or "coefficients over one period") + band, fontsize="medium",
+                 y=1 - 0.12 / fig.get_figheight())
+    return fig
 
 
 def model_fit(lines, Y, Y_model, noise_std=None, *, w0=None, ax=None, hz=False):
@@ -562,52 +780,74 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
                 label=f"G_{k:+d} (data)" if k else "G_0 (data)")
         if over.any():
             ax.plot(x[over], _db(mag[over]), "x", ms=4.5, color=color, alpha=alpha)
-    if est.overlapped is not None and est.overlapped.any():
-        ax.plot([], [], "x", color="0.3", label="overlapped by neighbours' branches (biased)")
         if G_model is not None:
             ax.plot(x, _db(G_model[i]), "-", lw=1.0, color=color, alpha=alpha)
+    if est.overlapped is not None and est.overlapped.any():
+        ax.plot([], [], "x", color="0.3", label="overlapped by neighbours' branches (biased)")
     if G_model is not None:
         ax.plot([], [], "-", color="0.3", lw=1.0, label="model")
-    ax.set_xscale("log")
+    _log_x(ax)
     ax.set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
     ax.set_ylabel("|G_k| (dB)")
-    ax.set_title(f"HTF branches from {est.periods} periods (shaded: +-2 std; faint: within the noise)")
+    ax.set_title(f"HTF branches from {est.periods} periods (shaded: +-2 std; faint: within the noise)",
+                 fontsize="medium")
     ax.legend(fontsize=7, ncol=2)
-    ax.grid(True, which="both", alpha=0.3)
     return ax
 
 
 def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig=None):
-    """Bode plot of an identification: the measured FRF ``Y / U`` on the excited lines with +-2
-    standard deviations (from the periods' noise), the model's (time-averaged) frequency response
-    and its ``level`` band from the parameter covariance. Log-frequency axis in rad/s (or Hz).
-    For a fit of several experiments, each experiment's measured FRF on its own excited lines,
-    with its own marker.
+    """Bode plot of an identification against the measured ``Y / U`` on the excited lines (with
+    +-2 standard deviations from the periods' noise, input and output). Log-frequency axis in
+    rad/s (or Hz). For a fit of several experiments, each experiment's measured ratio on its own
+    excited lines, with its own marker.
 
-    Returns the figure (magnitude on top, phase below).
+    LTI model: its frequency response with the ``level`` band from the parameter covariance
+    (magnitude on top, phase below), the curve the measured points should follow.
+
+    LPTV model: the measured ratio on line l holds every branch's share,
+    ``Y_l / U_l = sum_k G_k(w_{l-k}) U_{l-k} / U_l``, so it is compared with what the model
+    predicts from the measured input on the same lines (``simulate(model, U)[l] / U_l``, its
+    ``level`` band from the parameter covariance, first order), not with the branch G_0. A
+    third panel draws the model's branches |G_k(w)|, k = -K..K, and, where the record determines
+    them (excited lines more than 2K apart: :func:`lptv.htf_estimate`; entries overlapped by
+    neighbouring lines' far branches left out), their nonparametric estimates with +-2 std.
+
+    Returns the figure.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> m = lptv.Model([[6.0, 40.0, 6.0], [0, 0.8, 0], [0, 1.0, 0]], [[1.0]], w0=2 * np.pi / 5)
+    >>> ms = lptv.multisine(range(1, 31), 1000, seed=0)
+    >>> y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 1000)
+    >>> rng = np.random.default_rng(1)
+    >>> u = ms.periods(8) + 1e-3 * rng.standard_normal((8, 1000))
+    >>> y = np.tile(y1, (8, 1)) + 1e-5 * rng.standard_normal((8, 1000))
+    >>> res = lptv.identify(u, y, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=m.w0)
+    >>> fig = lptv.plots.bode(res)
+    >>> [ax.get_ylabel() for ax in fig.axes]
+    ['|Y/U| (dB)', 'phase of Y/U (deg)', '|G_k| (dB)']
     """
-    from .identify import IdentificationResult
-    from .parameters import _z, freqresp_band
-    from scipy.stats import norm
-    from ._validate import as_bool, as_int
+    from .identify import IdentificationResult, excited_rows
+    from ._validate import as_bool, as_float, as_int
 
     if not isinstance(res, IdentificationResult):
         raise ValueError(f"res must be an lptv.IdentificationResult, got {type(res).__name__}")
     if res.data is None and not res.experiments:
         raise ValueError("res must carry its data (res.data is None)")
     hz = as_bool(hz, "hz")
-    _z(level)
+    level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
     n_points = as_int(n_points, "n_points", minimum=2, maximum=100_000)
-    if fig is None:
-        from matplotlib.figure import Figure
-
-        fig = Figure(figsize=(6.4, 5.6), layout="constrained")
-    ax_m, ax_p = fig.subplots(2, 1, sharex=True)
     model = res.model
-    from .identify import excited_rows
+    lti = model.is_lti
+    if fig is None:
+        fig, axes = _figure((6.4, 5.6 if lti else 7.8), 2 if lti else 3, 1, sharex=True, hspace=0.3)
+    else:
+        axes = fig.subplots(2 if lti else 3, 1, sharex=True, squeeze=False)
+    ax_m, ax_p = axes[0, 0], axes[1, 0]
 
     def excited_only(d, rows):
-        # Y/U is the FRF only where the input is excited: the verdict's rows also hold the +-K
+        # Y/U is read only where the input is excited: the verdict's rows also hold the +-K
         # sidebands of an LPTV model, where U is noise and Y/U means nothing.
         try:
             keep = rows[np.isin(rows, excited_rows(d, 0))]
@@ -617,63 +857,181 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
 
     if res.data is not None:
         sets = [("measured Y/U (+-2 std)", res.data, excited_only(res.data, np.asarray(res.verdict_lines)))]
-    else:  # several experiments: each one's measured FRF on its own excited lines
+    else:  # several experiments: each one's measured ratio on its own excited lines
         mask, exp = res.verdict_mask, np.asarray(res.experiment)
         sets = [(f"experiment {e} Y/U (+-2 std)", d, excited_only(d, res.lines[mask & (exp == e)]))
                 for e, d in enumerate(res.experiments)]
         sets = [s for s in sets if s[2].size]
-    all_lines = np.concatenate([s[2] for s in sets])
-    w_all = all_lines * model.w0
     scale = 1 / (2 * np.pi) if hz else 1.0
-    wmax = np.pi / model.ts if model.discrete else w_all.max() * 1.5
-    w = np.logspace(np.log10(w_all.min() / 1.5), np.log10(min(wmax, w_all.max() * 1.5)), n_points)
-    H, s_abs, s_ph = freqresp_band(res, w)
-    z = norm.ppf(0.5 + level / 2)
-    x = w * scale
-    if s_abs is not None:
-        ax_m.fill_between(x, _db(np.maximum(np.abs(H) - z * s_abs, 1e-300)), _db(np.abs(H) + z * s_abs),
-                          color="C1", alpha=0.3, lw=0, label=f"model {100 * level:g} % band")
-        ax_p.fill_between(x, np.degrees(np.unwrap(np.angle(H)) - z * s_ph),
-                          np.degrees(np.unwrap(np.angle(H)) + z * s_ph), color="C1", alpha=0.3, lw=0)
-    ph_model = np.degrees(np.unwrap(np.angle(H)))
+    z = _z_of(level)
     markers = "osD^v<>"
+    shown = []
+    curve = None
+    if lti:
+        from .parameters import freqresp_band
+
+        w_all = np.concatenate([s[2] for s in sets]) * model.w0
+        wmax = np.pi / model.ts if model.discrete else w_all.max() * 1.5
+        w = np.logspace(np.log10(w_all.min() / 1.5), np.log10(min(wmax, w_all.max() * 1.5)), n_points)
+        H, s_abs, s_ph = freqresp_band(res, w)
+        ph_model = np.degrees(np.unwrap(np.angle(H)))
+        x = w * scale
+        if s_abs is not None:
+            ax_m.fill_between(x, _db(np.maximum(np.abs(H) - z * s_abs, 1e-300)), _db(np.abs(H) + z * s_abs),
+                              color="C1", alpha=0.3, lw=0, label=f"model {100 * level:g} % band")
+            ax_p.fill_between(x, ph_model - np.degrees(z * s_ph), ph_model + np.degrees(z * s_ph),
+                              color="C1", alpha=0.3, lw=0)
+        ax_m.plot(x, _db(H), "-", color="C1", lw=1.2, label="model")
+        ax_p.plot(x, ph_model, "-", color="C1", lw=1.2)
+        shown.append(_db(H))
+        curve = (w, ph_model)
     for i, (label, d, rows) in enumerate(sets):
         color = "C0" if i == 0 else f"C{i + 1}"  # C1 is the model's
+        rows = np.sort(rows)
         U, Y = d.U[rows], d.Y[rows]
         G = Y / U
-        varG = (d.varY[rows] + np.abs(G) ** 2 * d.varU[rows]
-                - 2 * np.real(np.conj(G) * d.covYU[rows])) / np.abs(U) ** 2
-        sG = np.sqrt(np.maximum(varG, 0.0))
-        w_lines = rows * model.w0
-        ax_m.errorbar(w_lines * scale, _db(G),
+        sG = _ratio_std(d, rows, G)
+        xl = rows * model.w0 * scale
+        if lti:
+            ref_ph = np.interp(rows * model.w0, *curve)
+        else:
+            Gp, sp_abs, sp_ph = _predicted_ratio(res, d, rows)
+            ph_p = np.degrees(np.unwrap(np.angle(Gp)))
+            pred = "model's prediction from the measured input" + (f" ({100 * level:g} % band)"
+                                                                  if sp_abs is not None else "")
+            pred_label = pred if i == 0 else None
+            if sp_abs is not None:
+                ax_m.fill_between(xl, _db(np.maximum(np.abs(Gp) - z * sp_abs, 1e-300)),
+                                  _db(np.abs(Gp) + z * sp_abs), color="C1", alpha=0.3, lw=0)
+                ax_p.fill_between(xl, ph_p - np.degrees(z * sp_ph), ph_p + np.degrees(z * sp_ph),
+                                  color="C1", alpha=0.3, lw=0)
+            ax_m.plot(xl, _db(Gp), "-", color="C1", lw=1.0, marker=".", ms=4, label=pred_label)
+            ax_p.plot(xl, ph_p, "-", color="C1", lw=1.0, marker=".", ms=4)
+            shown.append(_db(Gp))
+            ref_ph = ph_p
+        ax_m.errorbar(xl, _db(G),
                       yerr=[_db(np.abs(G)) - _db(np.maximum(np.abs(G) - 2 * sG, 1e-300 + 0 * sG)),
                             _db(np.abs(G) + 2 * sG) - _db(G)],
-                      fmt=markers[i % len(markers)], ms=3.5, mfc="none", color=color, elinewidth=0.8, label=label)
-        # put the measured phase on the model's branch
+                      fmt=markers[i % len(markers)], ms=3.5, mfc="none", color=color, elinewidth=0.8,
+                      label=label, zorder=3)
+        # the measured phase on the model's branch of the phase
         ph_meas = np.degrees(np.angle(G))
-        ph_at = np.interp(w_lines, w, ph_model)
-        ph_meas = ph_meas + 360 * np.round((ph_at - ph_meas) / 360)
-        ax_p.errorbar(w_lines * scale, ph_meas, yerr=2 * np.degrees(sG / np.abs(G)),
-                      fmt=markers[i % len(markers)], ms=3.5, mfc="none", color=color, elinewidth=0.8)
-    ax_m.plot(x, _db(H), "-", color="C1", lw=1.2, label="model")
-    ax_p.plot(x, ph_model, "-", color="C1", lw=1.2)
+        ph_meas = ph_meas + 360 * np.round((ref_ph - ph_meas) / 360)
+        ax_p.errorbar(xl, ph_meas, yerr=2 * np.degrees(np.minimum(sG / np.abs(G), np.pi)),
+                      fmt=markers[i % len(markers)], ms=3.5, mfc="none", color=color, elinewidth=0.8, zorder=3)
+        shown.append(_db(G))
     # The view follows the points and the model: an error bar reaching |G| = 0 (a line where the
     # noise is as large as the response) would otherwise stretch the axis to -6000 dB.
-    shown = np.concatenate([_db(H)] + [_db(s[1].Y[s[2]] / s[1].U[s[2]]) for s in sets])
+    shown = np.concatenate(shown)
     shown = shown[np.isfinite(shown)]
     if shown.size:
         span = max(float(shown.max() - shown.min()), 1.0)
         ax_m.set_ylim(shown.min() - 0.15 * span - 3.0, shown.max() + 0.15 * span + 3.0)
-    for ax in (ax_m, ax_p):
-        ax.set_xscale("log")
-        ax.grid(True, which="both", alpha=0.3)
-    ax_m.set_ylabel("magnitude (dB)")
-    ax_p.set_ylabel("phase (deg)")
-    ax_p.set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
-    ax_m.legend(fontsize="small")
-    kind = "" if model.is_lti else " (time-averaged, branch G_0)"
-    ax_m.set_title(f"Bode plot{kind}: measured and identified")
+    for ax in axes[:, 0]:
+        _log_x(ax)
+    ax_m.set_ylabel("|Y/U| (dB)")
+    ax_p.set_ylabel("phase of Y/U (deg)")
+    axes[-1, 0].set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
+    ax_m.legend(fontsize="small" if len(sets) < 3 else "x-small", ncol=1 if len(sets) < 3 else 2)
+    if lti:
+        ax_m.set_title("Bode plot: the measured Y/U and the identified model", fontsize="medium")
+    else:
+        ax_m.set_title("Y/U on the excited lines: measured, and predicted by the model", fontsize="medium")
+        _branches_panel(axes[2, 0], res, sets, scale, min(n_points, 120))
     return fig
+
+
+def _ratio_std(d, rows, G):
+    """Standard deviation of the measured ratio Y/U on ``rows`` from the periods' noise on input
+    and output and their covariance (first order)."""
+    varG = (d.varY[rows] + np.abs(G) ** 2 * d.varU[rows]
+            - 2 * np.real(np.conj(G) * d.covYU[rows])) / np.abs(d.U[rows]) ** 2
+    return np.sqrt(np.maximum(varG, 0.0))
+
+
+def _predicted_ratio(res, d, rows):
+    """The model's output from the measured input over that input, Y_model,l / U_l on ``rows``,
+    with the standard deviations of its magnitude and phase (rad) from the parameter covariance
+    (central differences of the simulated output over the parameters, first order); the stds are
+    None without a covariance."""
+    from .fds import simulate
+    from .parameters import perturbed_model
+
+    model = res.model
+    U = d.U[rows]
+    Yp = np.asarray(simulate(model, d.U, warn_unstable=False))[rows]
+    cov = res.covariance
+    if cov is None:
+        return Yp / U, None, None
+    eta = np.asarray(res.eta, float)
+    J_abs = np.zeros((rows.size, eta.size))
+    J_ph = np.zeros((rows.size, eta.size))
+    for i, name in enumerate(res.eta_names):
+        if not cov[i, i] > 0:
+            continue
+        h = 1e-6 * max(abs(eta[i]), 1e-3)
+        Ypp, Ypm = (np.asarray(simulate(perturbed_model(model, name, s * h), d.U, warn_unstable=False))[rows]
+                    for s in (1, -1))
+        dY = (Ypp - Ypm) / (2 * h)
+        J_abs[:, i] = np.real(dY * np.conj(Yp)) / np.maximum(np.abs(Yp), 1e-300)
+        J_ph[:, i] = np.imag(dY / np.where(Yp == 0, 1, Yp))
+    s_abs = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", J_abs, cov, J_abs), 0.0))
+    s_ph = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", J_ph, cov, J_ph), 0.0))
+    return Yp / U, s_abs / np.abs(U), s_ph
+
+
+def _branch_color(k: int) -> str:
+    return "0.15" if k == 0 else f"C{(2 * abs(k) + (k < 0)) % 10}"
+
+
+def _branches_panel(ax, res, sets, scale, n_points):
+    """The model's HTF branches over the excited band and, where the record determines them, their
+    nonparametric estimates (lptv.htf_estimate) with +-2 std."""
+    from .nonparametric import htf_estimate
+
+    model = res.model
+    K = max(model.ka, model.kb)
+    lines = np.concatenate([s[2] for s in sets])
+    w_lo, w_hi = lines.min() * model.w0 / 1.2, lines.max() * model.w0 * 1.2
+    if model.discrete:
+        w_hi = min(w_hi, np.pi / model.ts)
+    w = np.logspace(np.log10(w_lo), np.log10(w_hi), n_points)
+    order = sorted(range(-K, K + 1), key=abs)
+    for k in order:
+        ax.plot(w * scale, _db(model.freqresp(w, branch=k)), "-", lw=1.2, color=_branch_color(k),
+                label=f"G_{k:+d}" if k else "G_0")
+    why = []
+    drawn = False
+    for i, (_, d, rows) in enumerate(sets):
+        try:
+            est = htf_estimate(d, excited=np.sort(rows), branches=K)
+        except ValueError as e:
+            why.append(str(e))
+            continue
+        over = est.overlapped if est.overlapped is not None else np.zeros(est.G.shape, bool)
+        for j, k in enumerate(est.k):
+            keep = ~over[j]
+            if not keep.any():
+                continue
+            mag, sd = np.abs(est.G[j][keep]), est.std[j][keep]
+            ax.errorbar(est.w[keep] * scale, _db(mag),
+                        yerr=[_db(mag) - _db(np.maximum(mag - 2 * sd, mag * 1e-3)), _db(mag + 2 * sd) - _db(mag)],
+                        fmt="osD^v<>"[i % 7], ms=3.5, mfc="none", color=_branch_color(int(k)), elinewidth=0.8,
+                        ls="none")
+            drawn = True
+    if drawn:
+        ax.errorbar([], [], yerr=[], fmt="o", ms=3.5, mfc="none", color="0.3", ls="none",
+                    label="from the data, +-2 std")
+        ax.set_title("HTF branches: the model's, and where the record separates them, the data's",
+                     fontsize="medium")
+    else:
+        ax.set_title("HTF branches of the model (the record does not separate them)", fontsize="medium")
+        reason = ("excited lines closer than 2K + 1 apart" if any("apart" in m or "close" in m for m in why)
+                  else "no entry of the data free of its neighbours' branches")
+        ax.text(0.02, 0.04, f"no nonparametric estimate: {reason}", transform=ax.transAxes, fontsize="small",
+                color="0.3")
+    ax.set_ylabel("|G_k| (dB)")
+    ax.legend(fontsize="small", ncol=min(2 * K + 2, 4))
 
 
 def compare(cmp, *, ax=None, unit: str = ""):
@@ -711,11 +1069,10 @@ def inspection(insp, *, hz: bool = False, fig=None):
     if not isinstance(insp, Inspection):
         raise ValueError(f"insp must be an lptv.Inspection (from lptv.inspect), got {type(insp).__name__}")
     hz = as_bool(hz, "hz")
-    if fig is None:
-        from matplotlib.figure import Figure
-
-        fig = Figure(figsize=(6.4, 6.4 if insp.repeats else 3.2), layout="constrained")
-    axes = fig.subplots(2 if insp.repeats else 1, 1, squeeze=False)[:, 0]
+    rows = 2 if insp.repeats else 1
+    axes = (_figure((6.4, 6.4 if insp.repeats else 3.2), rows, 1, hspace=0.85)[1] if fig is None
+            else fig.subplots(rows, 1, squeeze=False))[:, 0]
+    fig = axes[0].figure
     ax = axes[0]
     lag = insp.lags[1:]
     x = lag / insp.fs if insp.fs else lag

@@ -1063,6 +1063,9 @@ def cli_cases():
         add(f"identify-max-iter-{v}", ok + ("--max-iter", v), "--max-iter")
     for v in ("abc", "a1=nan", "a9=1", "q1=1", "a1=1,a1=2"):
         add(f"identify-known-{v}", ok + ("--known", v), "--known")
+    for v in ("abc", "b0", "b0=0", "b0=nan", "b9=1", "q1=1", "b0=x"):
+        add(f"identify-scale-{v}", ok + ("--scale", v), "--scale")
+    add("identify-scale-with-known", ok + ("--scale", "b0=1", "--known", "b0=1"), "--scale")
     add("identify-method-bogus", ok + ("--method", "ml"), "--method")
     add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
     add("identify-noise-bogus", ok + ("--noise", "smooth"), "--noise")

@@ -41,7 +41,9 @@ import numpy as np
 
 from lptv import NumericalError, distortion, identify, parameter_table, plots
 from lptv.apps.options import verdict_status
-from lptv.apps.report import Report, model_figures, write_fit
+from lptv.apps import units
+from lptv.apps.report import Report, model_figures, parameter_section, write_fit
+from lptv.parameters import format_parameter_table
 
 
 def _fail(src, problem) -> int:
@@ -138,7 +140,18 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     for msg in extra:
         print(f"warning: {msg}")
     summary = _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit, referred)
-    failed = write_fit(out, res.model, summary, lambda: _report(src, meas, dist, res, summary))
+    scale = units.parse_scale(getattr(args, "scale", None))
+    try:
+        physical = units.scaled(res, *scale) if scale else None
+    except ValueError as e:
+        return _fail(src, e)
+    if physical is not None:
+        print(f"parameters in physical form (--scale {scale[0]}={scale[1]:g}):")
+        print(format_parameter_table(physical).replace("(normalised)", "(by --scale)"))
+    summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
+    summary["parameters_scaled"] = None if physical is None else parameter_table(physical)
+    failed = write_fit(out, res.model, summary, None if getattr(args, "no_report", False) else
+                       lambda: _report(src, meas, dist, res, summary, known=known))
     return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)
 
 
@@ -188,10 +201,11 @@ def _summary(args, src, meas, w0, ts, ka, kb, dist, res, extra, first_fit=None, 
     }
 
 
-def _report(src, meas, dist, res, summary) -> Report:
+def _report(src, meas, dist, res, summary, known=None) -> Report:
     model = res.model
     M, P, N = meas.u.shape
     rep = Report(f"lptv identify: {Path(src).name} ({M} realisations)")
+    rep.verdict(res.verdict, res.model_ok)
     rep.paragraph(
         f"{M} random-phase realisations of {P} periods of {N} samples in {src}. Per output line the "
         "noise level of a period mean (from the periods) and the stochastic nonlinear distortion (what "
@@ -233,7 +247,10 @@ def _report(src, meas, dist, res, summary) -> Report:
            "which holds whatever the distortion's correlation across lines, corrected for realisations "
            "of unequal information and scaled to the t quantile of its degrees of freedom ("
            + _dof_range(res) + ")." if summary.get("covariance") == "realisations" else ""))
-    rep.paragraph("Verdict: " + res.verdict + ".")
+    scale = summary.get("scale")
+    u_unit, y_unit = units.channel_unit(meas.input), units.channel_unit(meas.output)
+    physical = parameter_section(rep, res, scale=(scale["coefficient"], scale["value"]) if scale else None,
+                                 known=known, u_unit=u_unit, y_unit=y_unit)
     if res.lack_of_fit is not None:
         rep.figure(plots.lack_of_fit(res.lack_of_fit, w0=model.w0).figure, "lack_of_fit.png",
                    "The verdict's test: on each judged output line the model's prediction against the "
@@ -241,9 +258,14 @@ def _report(src, meas, dist, res, summary) -> Report:
                    "the lines above the 1 % line when the model is the best linear approximation). The "
                    "decision is the permutation test of all lines together, in the title (METHOD.md "
                    "section 16).")
-    rep.preformatted(res.summary())
     rep.figure(plots.bode(res), "bode.png",
                "Each realisation's measured FRF Y/U on its excited lines (+-2 std from its periods) and the "
-               "model's time-averaged response with its 95 % band from the parameter covariance.")
-    model_figures(rep, model)
+               "model's response with its 95 % band from the parameter covariance"
+               + ("." if model.is_lti else
+                  ": for a time-varying model the output the model predicts from each realisation's measured "
+                  "input over that input (Y/U on a line holds every branch's share, not G_0 alone); below, "
+                  "the model's HTF branches G_k with their nonparametric estimates where a realisation "
+                  "separates them (lptv.htf_estimate; entries its neighbours' far branches overlap left out)."))
+    model_figures(rep, res, physical=physical, u_unit=u_unit, y_unit=y_unit)
+    rep.preformatted(res.summary())
     return rep

@@ -171,7 +171,9 @@ def run(args) -> int:
         "frequency domain, measured over P noisy periods, and identified from data where both input "
         "and output are noisy. Every choice is stated in lptv.examples and lptv.apps.demo; every random "
         f"number comes from seed {seed}.")
+    rep.verdict(f"WGTLS: {wg.verdict}; SML: {sm.verdict}", wg.model_ok and sm.model_ok)
     rep.table(["quantity", "value"], _summary_rows(summary))
+    _parameter_table(rep, model, wg, sm)
     rep.heading("Simulation: FDS against time integration")
     n_plot = 300
     ax = plots.output_spectrum(np.arange(n_plot), Y_fds[:n_plot], Y_cvode[:n_plot], w0=model.w0)
@@ -272,6 +274,27 @@ def _summary_rows(s):
         ["Floquet spectral radius of the damped Mathieu equation",
          f"{s['mathieu_floquet_spectral_radius']:.4f}"],
     ]
+
+
+def _parameter_table(rep, model, wg, sm):
+    """The free parameters: true, WGTLS and SML estimates with their standard deviations, and the
+    SML error in units of its standard deviation."""
+    true = _eta_of(model, sm.eta_names)
+    s_wg, s_sm = wg.parameter_std, sm.parameter_std
+    rows = []
+    for i, name in enumerate(sm.eta_names):
+        if s_sm[i] == 0:
+            rows.append([name, f"{true[i]:.5g}", f"{wg.eta[i]:.5g}", "normalised", f"{sm.eta[i]:.5g}", "normalised", "-"])
+            continue
+        rows.append([name, f"{true[i]:.5g}", f"{wg.eta[i]:.5g}", f"{s_wg[i]:.2g}", f"{sm.eta[i]:.5g}", f"{s_sm[i]:.2g}",
+                     f"{(sm.eta[i] - true[i]) / s_sm[i]:+.2f}"])
+    rep.heading("Parameters")
+    rep.paragraph(f"The {len(rows) - 1} free real parameters (a0.re1, a0.im1: real and imaginary part of harmonic 1 "
+                  "of a_0(t)) with their standard deviations from each estimator's covariance (WGTLS: the "
+                  "analytic sandwich; SML: the inverse Fisher information with the noise variances' "
+                  "correction, METHOD.md section 10). Both are normalised: the mean of a2 is 1 (the equation "
+                  "holds for any common factor of its coefficients), as in the true model.")
+    rep.table(["parameter", "true", "WGTLS", "std", "SML", "std", "(SML - true) / std"], rows)
 
 
 def _eta_of(model, names):

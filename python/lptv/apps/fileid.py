@@ -53,8 +53,10 @@ from lptv.apps.options import (OPTION_NAMES, describe_record, fundamental, in_op
                                read_record)
 from lptv.apps import inspectrec
 from lptv.apps.options import verdict_status
+from lptv.apps import units
 from lptv.apps.report import Report, write_fit
 from lptv import METHODS
+from lptv.parameters import format_parameter_table
 from lptv.measurements import FileError
 
 # ------------------------------------------------------------------------------ options
@@ -159,6 +161,12 @@ def add_parser(sub):
                    "or --fs that contradicts the one found in the data, a record that does not repeat); "
                    "the contradiction is then printed as a warning")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
+    p.add_argument("--scale", metavar="b0=1",
+                   help="report the parameters in physical form: all scaled so that the mean of this "
+                   "coefficient has this value (the fit sets the mean of a_na to 1; for m x'' + c x' + k x = F, "
+                   "--scale b0=1 gives a2 = m, a1 = c, a0 = k); the fit and its verdict are unchanged")
+    p.add_argument("--no-report", action="store_true",
+                   help="write model.json and summary.json only (no report.html and figures: faster)")
     p.add_argument("--out", help="output folder (default: <file stem>-lptv/)")
     p.add_argument("--max-iter", type=int, default=50, help="WGTLS iterations at most (default 50)")
     p.add_argument("--tol", type=float, default=1e-10, help="WGTLS relative tolerance (default 1e-10)")
@@ -268,6 +276,9 @@ def run(args) -> int:
     try:
         lines = parse_lines(args.lines) if args.lines is not None else None
         ka, kb, known = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb"), parse_known(args.known)
+        scale = units.parse_scale(getattr(args, "scale", None))
+        if scale and known:
+            raise FileError("--scale: the known coefficients (--known) already fix the scale of the parameters")
         if args.max_iter < 0:
             raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
         for opt in ("na", "nb", "max_iter"):
@@ -315,6 +326,7 @@ def run(args) -> int:
                            seed=0, noise=args.noise,
                            disturbances="remove" if args.remove_disturbances else None)
             Y_pred = simulate(res.model, res.data.U, warn_unstable=False)
+        physical = units.scaled(res, *scale) if scale else None
     except NumericalError as e:
         return _fail(src, e, status=1)
     except (FileError, ValueError) as e:
@@ -340,13 +352,19 @@ def run(args) -> int:
     if meas.trimmed or meas.skipped:
         print(f"dropped at the start: {meas.trimmed} samples (--trim), {meas.skipped} periods (--skip-periods)")
     print(res.summary())
+    if physical is not None:
+        print(f"parameters in physical form (--scale {scale[0]}={scale[1]:g}):")
+        print(format_parameter_table(physical).replace("(normalised)", "(by --scale)"))
     for msg in extra:
         print(f"warning: {msg}")
     if not args.remove_disturbances and any("too small" in e for e in res.model_errors):
         print("hint: residues below the noise: if the structure is not over-fitted, a sinusoid that is not "
               "periodic in the record may inflate the noise estimate; --remove-disturbances finds and removes it")
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
-    failed = write_fit(out, res.model, summary, lambda: _report(src, meas, res, Y_pred, summary))
+    summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
+    summary["parameters_scaled"] = None if physical is None else parameter_table(physical)
+    failed = write_fit(out, res.model, summary, None if getattr(args, "no_report", False) else
+                       lambda: _report(src, meas, res, Y_pred, summary, known=known))
     return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)
 
 
@@ -394,45 +412,60 @@ def _json_lti(res):
     return t
 
 
-def _report(src, meas, res, Y_pred, summary) -> Report:
+def _report(src, meas, res, Y_pred, summary, known=None) -> Report:
+    from lptv.apps.report import coefficient_figure, parameter_section, residue_tests_section
+    from lptv.apps.units import channel_unit
+
     model, d, rows = res.model, res.data, res.lines
     P, N = meas.u.shape
     lo, hi = res.fraction_band
+    u_unit, y_unit = channel_unit(meas.input), channel_unit(meas.output)
     rep = Report(f"lptv identify: {Path(src).name}")
     rep.paragraph(
         f"A model with na = {model.na}, nb = {model.nb}, {summary['ka']} harmonics on the a_n and "
         f"{summary['kb']} on the b_m ({res.n_free_parameters} free parameters) identified by "
         f"{res.method.upper()} from {P} periods of {N} samples in {src}, on {rows.size} lines "
         f"({rows.min()} to {rows.max()}).")
-    rep.paragraph("Verdict: " + res.verdict + ".")
+    rep.verdict(res.verdict, res.model_ok)
     var = "y[t+n]" if model.discrete else "d^n y/dt^n"
     rep.preformatted(f"model: sum_n a_n(t) {var} = sum_m b_m(t) {var.replace('y', 'u').replace('n', 'm')}, "
-                     f"n = 0..{model.na}, m = 0..{model.nb}, a_n(t) = sum_k a_n,k exp(j k w0 t)\n"
-                     + res.summary())
+                     f"n = 0..{model.na}, m = 0..{model.nb}, a_n(t) = sum_k a_n,k exp(j k w0 t)")
+    scale = summary.get("scale")
+    physical = parameter_section(rep, res, scale=(scale["coefficient"], scale["value"]) if scale else None,
+                                 known=known, u_unit=u_unit, y_unit=y_unit)
+    rep.heading("The model against the data")
     try:
-        rep.figure(plots.bode(res), "bode.png",
-                   "Measured frequency response Y/U on the excited lines (+-2 standard deviations from the "
-                   "periods) and the model's, with its 95 % band from the parameter covariance.")
+        if model.is_lti:
+            caption = ("Measured frequency response Y/U on the excited lines (+-2 standard deviations from the "
+                       "periods, input and output noise) and the model's, with its 95 % band from the parameter "
+                       "covariance.")
+        else:
+            caption = ("Top: the measured Y/U on the excited lines (+-2 standard deviations from the periods) and "
+                       "the model's output predicted from the measured input over that input, with its 95 % band "
+                       "from the parameter covariance. For a time-varying system Y/U on a line holds every "
+                       "excited line's contribution through the branches G_k, so it is this prediction, not the "
+                       "branch G_0 alone, that the measured points must follow. Bottom: the model's HTF branches "
+                       "G_k (input line l to output line l + k)"
+                       ", with their nonparametric estimates (lptv.htf_estimate) where the record separates them.")
+        rep.figure(plots.bode(res), "bode.png", caption)
         cmp = compare(res, meas.u, meas.y)
-        rep.figure(plots.compare(cmp).figure, "compare.png",
+        rep.figure(plots.compare(cmp, unit=y_unit or "").figure, "compare.png",
                    f"Measured output (mean of the periods) and the model's output simulated from the measured "
                    f"input over one period: fit {cmp['fit']:.1f} % = 100 (1 - ||y - yhat|| / ||y - mean y||).")
         summary["fit_percent"] = cmp["fit"]
     except (ValueError, NumericalError, np.linalg.LinAlgError):
         pass
     gap = summary["prediction_error_vs_noise_db"]
-    rep.table(["quantity", "value"], [
-        ["file", f"{src} ({meas.format})"],
-        ["periods x samples", f"{P} x {N}"],
-        ["w0 (rad/s)", f"{model.w0:.6g}" + (f", ts = {model.ts:g} s" if model.discrete else "")],
-        ["na, nb; harmonics ka, kb", f"{model.na}, {model.nb}; {summary['ka']}, {summary['kb']}"],
-        ["lines of the fit", f"{rows.size} ({rows.min()} to {rows.max()})"],
-        ["method, iterations, converged", f"{res.method}, {res.iterations}, {res.converged}"],
-        ["normalised residues above 0 dB", f"{100 * res.fraction_above_0db:.1f} % (expected "
-         f"{100 * res.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %)"],
-        ["output residue against the noise", "-" if gap is None else f"{gap:+.1f} dB"],
-    ])
+    ax = plots.model_fit(rows, d.Y[rows], Y_pred[rows], np.sqrt(d.varY[rows]), w0=model.w0)
+    rep.figure(ax.figure, "output_spectrum.png",
+               "Measured output spectrum (dots) on every line of the fit, the output the model predicts from the "
+               "measured input (open circles), their difference and the noise standard deviation of the mean of "
+               f"the {P} periods (one period's is sqrt({P}) larger). "
+               + (f"The difference is on average {gap:+.1f} dB from the noise level; a good model keeps "
+                  "it near the noise (the measured input is noisy too), far below |Y| on the excited lines."
+                  if gap is not None else ""))
 
+    rep.heading("The verdict's evidence")
     vlo, vhi = res.verdict_band
     ax = plots.normalized_residue(rows, res.normalized_residue, w0=model.w0, excited=res.verdict_lines)
     ax.set_title(f"excited lines: {100 * res.verdict_fraction:.1f} % above 0 dB "
@@ -445,21 +478,12 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
                f"{100 * vlo:.1f}-{100 * vhi:.1f} %; on all {rows.size} lines of the fit "
                f"{100 * res.fraction_above_0db:.1f} % (expected {100 * res.fraction_expected:.1f} %, band "
                f"{100 * lo:.1f}-{100 * hi:.1f} %). The verdict judges the {res.judged_lines.size} rows "
-               "that read a line with signal, by the tests in the table below. "
+               "that read a line with signal, by the tests below. "
                + ("The fit shows no sign of modelling errors." if res.model_ok else
                   "The model is rejected: " + "; ".join(res.model_errors) + "."))
-    tests = _json_residue_tests(res)
-    if tests:
-        rep.table(["residue test (rows)", "rows", "z", "p", "Holm-adjusted p", "rejects at 1 %"],
-                  [[t["name"], t["n_rows"], t["statistic"], t["p_value"], t["p_holm"], t["rejects"]]
-                   for t in tests])
-        ax = plots.residue_tests(res)
-        rep.figure(ax.figure, "residue_tests.png",
-                   "The verdict's residue tests: per group of rows at the same distance d from the "
-                   "nearest excited line, and over all rows with signal, the sum of the rows' normal "
-                   "scores over its standard deviation (standard normal without a model error); a bar "
-                   "above the dashed line rejects (Holm's method, overall size 1 %, METHOD.md section 7).")
+    residue_tests_section(rep, res)
 
+    rep.heading("The model")
     t = np.linspace(0.0, model.period, 400)
     ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),
                                   discrete=model.discrete)
@@ -474,22 +498,21 @@ def _report(src, meas, res, Y_pred, summary) -> Report:
                    "t = 0 " + ("(z-plane, unitless, with the unit circle)" if model.discrete else "(s-plane, rad/s)")
                    + ". They show how the system varies and say nothing about the stability of the "
                    "time-varying system.")
-
-    ax = plots.model_fit(rows, d.Y[rows], Y_pred[rows], np.sqrt(d.varY[rows]), w0=model.w0)
-    rep.figure(ax.figure, "output_spectrum.png",
-               "Measured output spectrum (dots), the output the model predicts from the measured input "
-               "(open circles), their difference and the noise standard deviation of the mean of the "
-               f"{P} periods (one period's is sqrt({P}) larger). "
-               + (f"The difference is on average {gap:+.1f} dB from the noise level; a good model keeps "
-                  "it near the noise (the measured input is noisy too), far below |Y| on the excited lines."
-                  if gap is not None else ""))
-
-    names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
-    coef = np.hstack([model.a_at(t), model.b_at(t)]).real
-    ax = plots.coefficients(t, est=coef, names=names, ylabel="a_n(t), b_m(t)")
-    rep.figure(ax.figure, "coefficients.png",
-               "The estimated coefficients a_n(t) and b_m(t) over one period (normalised so that "
-               "the mean of a_na is 1, unless coefficients were given as known).")
+        coefficient_figure(rep, physical, u_unit=u_unit, y_unit=y_unit)
+    gap_row = ["output residue against the noise", "-" if gap is None else f"{gap:+.1f} dB"]
+    rep.heading("The fit")
+    rep.table(["quantity", "value"], [
+        ["file", f"{src} ({meas.format})"],
+        ["periods x samples", f"{P} x {N}"],
+        ["w0 (rad/s)", f"{model.w0:.6g}" + (f", ts = {model.ts:g} s" if model.discrete else "")],
+        ["na, nb; harmonics ka, kb", f"{model.na}, {model.nb}; {summary['ka']}, {summary['kb']}"],
+        ["lines of the fit", f"{rows.size} ({rows.min()} to {rows.max()})"],
+        ["method, iterations, converged", f"{res.method}, {res.iterations}, {res.converged}"],
+        ["normalised residues above 0 dB", f"{100 * res.fraction_above_0db:.1f} % (expected "
+         f"{100 * res.fraction_expected:.1f} %, band {100 * lo:.1f}-{100 * hi:.1f} %)"],
+        gap_row,
+    ])
+    rep.preformatted(res.summary())
     return rep
 
 

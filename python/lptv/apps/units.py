@@ -1,0 +1,142 @@
+"""The physical form of an identified model: its parameters with one coefficient's mean set by the
+user (``--scale b0=1``) and their covariance carried along, the unit of every coefficient from the
+channels' units (``force [N]``), and the coefficients over one period with their bands.
+
+The equation ``sum_n a_n(t) d^n y/dt^n = sum_m b_m(t) d^m u/dt^m`` holds for any common factor of
+its coefficients; the fit fixes it by the mean of ``a_na`` = 1 (the row 'normalised' of the
+parameter table). Dividing every parameter by the mean of another coefficient and multiplying by
+the value the user knows for it is the same model in other units: for a mass-spring-damper driven
+by a force, ``m x'' + c x' + k(t) x = F`` has ``b0 = 1``, and ``--scale b0=1`` reads ``a2`` as the
+mass, ``a1`` as the damping and ``a0`` as the stiffness. The covariance follows by the Jacobian of
+that division (exact to first order, as the covariance itself).
+"""
+from __future__ import annotations
+
+import re
+from types import SimpleNamespace
+from typing import Optional, Tuple
+
+import numpy as np
+
+from lptv.measurements import FileError
+
+_COEF = re.compile(r"([ab])(\d+)")
+
+
+def parse_scale(text: Optional[str]) -> Optional[Tuple[str, float]]:
+    """'b0=1' -> ('b0', 1.0); None -> None."""
+    if text is None:
+        return None
+    name, eq, value = text.partition("=")
+    name = name.strip()
+    try:
+        v = float(value)
+    except ValueError:
+        v = None
+    if not eq or not _COEF.fullmatch(name) or v is None or not np.isfinite(v) or v == 0:
+        raise FileError(f"--scale: '{text.strip()}' is not of the form coefficient=nonzero number "
+                        "(e.g. b0=1: the mean of b_0 is 1)")
+    return name, v
+
+
+def scaled(res, name: str, value: float) -> SimpleNamespace:
+    """The parameters of ``res`` (anything with ``model``, ``eta_names``, ``eta``, ``covariance``)
+    divided by the mean of coefficient ``name`` and multiplied by ``value``: an object with the
+    same four attributes (``lptv.parameter_table`` reads it) and ``scale = (name, value)``."""
+    from lptv import Model
+
+    names = list(res.eta_names)
+    key = f"{name}.re0"
+    if key not in names:
+        have = sorted({n.split(".")[0] for n in names}, key=lambda c: (c[0], int(c[1:])))
+        raise FileError(f"--scale: {name} is not a coefficient of the model ({', '.join(have)})")
+    eta = np.asarray(res.eta, float)
+    j = names.index(key)
+    s = eta[j]
+    cov = res.covariance
+    if s == 0:
+        raise FileError(f"--scale: the mean of {name} is estimated as 0; scale by another coefficient")
+    if cov is not None and cov[j, j] > 0 and abs(s) < 2 * np.sqrt(cov[j, j]):
+        raise FileError(f"--scale: the mean of {name} ({s:.3g}) is within two standard deviations of 0; "
+                        "scale by a coefficient the data determine")
+    f = value / s
+    out_eta = f * eta
+    out_cov = None
+    if cov is not None:
+        # d eta'_i / d eta_k = f (delta_ik - eta_i delta_kj / s)
+        J = f * np.eye(eta.size)
+        J[:, j] -= f * eta / s
+        out_cov = J @ cov @ J.T
+        out_cov[j, :] = out_cov[:, j] = 0.0        # the scaling coefficient is fixed: exactly `value`
+    m = res.model
+    model = Model(m.a * f, m.b * f, w0=m.w0, ts=m.ts)
+    return SimpleNamespace(model=model, eta_names=tuple(names), eta=out_eta, covariance=out_cov,
+                           scale=(name, value))
+
+
+def channel_unit(name: Optional[str]) -> Optional[str]:
+    """The unit a channel's name states at its end: 'force [N]' -> 'N', 'x (mm)' -> 'mm'."""
+    if not name:
+        return None
+    m = re.search(r"[\[(]\s*([^\[\]()]+?)\s*[\])]\s*$", str(name))
+    return m.group(1) if m else None
+
+
+def coefficient_units(model, u_unit: Optional[str], y_unit: Optional[str],
+                      scale: Optional[Tuple[str, float]] = None) -> dict:
+    """{'a0': 'N/m', 'a1': 'N s/m', ...}: each coefficient's unit when both channels state theirs
+    ({} otherwise). Every term of the equation has one unit E: a_n d^n y/dt^n is E, so a_n is
+    E s^n / [y] (E / [y] in discrete time, whose shifts carry no unit); the coefficient that is set
+    to a number (``scale``, else a_na) is a pure number, which fixes E."""
+    if not u_unit or not y_unit:
+        return {}
+    ct = not model.discrete
+    ref = scale[0] if scale else f"a{model.na}"
+    side, n = ref[0], int(ref[1:])
+    # E = [channel of ref] / s^n
+    base = {y_unit if side == "a" else u_unit: 1}
+    base_s = -n if ct else 0
+
+    def unit(chan, p):
+        e = dict(base)
+        e[chan] = e.get(chan, 0) - 1
+        e["s"] = e.get("s", 0) + base_s + (p if ct else 0)
+        num = [_tok(k, v) for k, v in e.items() if v > 0]
+        den = [_tok(k, -v) for k, v in e.items() if v < 0]
+        text = " ".join(num) or ("1" if den else "")
+        if den:
+            text += "/" + (den[0] if len(den) == 1 else "(" + " ".join(den) + ")")
+        return text
+
+    out = {f"a{i}": unit(y_unit, i) for i in range(model.na + 1)}
+    out.update({f"b{i}": unit(u_unit, i) for i in range(model.nb + 1)})
+    return out
+
+
+def _tok(name, power):
+    name = f"({name})" if re.search(r"[\s/*^]", name) else name
+    return name if power == 1 else f"{name}^{power}"
+
+
+def trajectories(src, t):
+    """The coefficients a_0..a_na, b_0..b_nb of ``src`` (a result or :func:`scaled`) at times ``t``:
+    (values, std or None, names), values and std of shape (len(t), na + nb + 2); the std from the
+    parameter covariance (each coefficient is linear in the parameters: its derivative is the
+    change for a unit step of one parameter)."""
+    from lptv.parameters import perturbed_model
+
+    model = src.model
+    names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]
+
+    def at(m):
+        return np.hstack([m.a_at(t), m.b_at(t)]).real
+
+    values = at(model)
+    cov = src.covariance
+    if cov is None:
+        return values, None, names
+    free = [i for i in range(len(src.eta_names)) if cov[i, i] > 0]
+    D = np.stack([at(perturbed_model(model, src.eta_names[i], 1.0)) - values for i in free], axis=-1)
+    C = cov[np.ix_(free, free)]
+    var = np.einsum("tci,ij,tcj->tc", D, C, D)
+    return values, np.sqrt(np.maximum(var, 0.0)), names
