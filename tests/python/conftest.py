@@ -381,3 +381,27 @@ RECORD_STD_UNITS = 1e-3
 RECORD_NOISE_VAR = 2 * RECORD_STD_UNITS
 RECORD_COST = 2 * RECORD_STD_UNITS
 RECORD_COVARIANCE = 1e-3 * RECORD_STD_UNITS
+
+# ==================================================================================================
+# The reports' figures (test_report_figures.py).
+# The measured Y/U drawn (dB and degrees) against NumPy's ratio of the periods' mean spectra: the
+# same FFT lines, then a dB / degree round trip, whose rounding is eps times |dB| ln(10) / 20 (about
+# 1e-14 at -60 dB). Measured: 8e-16.
+REPORT_MEASURED = 1e-12
+# The prediction drawn (the FDS, from the mean measured input) against CVODE's periodic steady
+# state of the same model from the same input at its default rtol 1e-12, relative to each line:
+# CVODE's error is a modest multiple of rtol of the output's peak, and the smallest excited line
+# of the rig lies 46 dB (200 times) below it: about 2e-10 expected there; 1e-8 leaves a factor
+# 50. Measured: 5e-11.
+REPORT_PREDICTED = 1e-8
+# Agreement "within the bands": the sum over n lines of |measured - predicted|^2 / var is a sum
+# of n Exp(1) terms (Gamma(n)) when the model is right; the test asks for it below this quantile
+# (the branch estimates: a chi-squared on n of their magnitudes).
+REPORT_CHI_LEVEL = 0.999
+# --scale b0=1 against --known b0=1: WGTLS's cost is invariant to a common factor of the
+# parameters, so both fits have the same minimiser up to that factor and differ by the stopping
+# rule (a relative step of 1e-10: 1e-10 of a value, far below 1e-6 of a std that is 1e-4 of it),
+# and the covariance by the Jacobian of the division, exact to first order (the sandwich is first
+# order itself) at the same point. Measured: 5e-11 std units, 1e-13 relative.
+SCALE_VS_KNOWN_STD_UNITS = 1e-6
+SCALE_VS_KNOWN_STD = 1e-8

@@ -37,7 +37,7 @@ def multisine(lines, period, seed):
 
 
 def mass_spring_damper(period, fs, periods, *, lines, noise=0.01, seed=0, variation=VARIATION,
-                       input_noise=None, start=0.0):
+                       input_noise=None, start=0.0, mass=MASS, damping=DAMPING, stiffness=STIFFNESS):
     """m x'' + c x' + k(t) x = f(t), k(t) = k0 (1 + variation cos(2 pi t / period)), from rest
     at t = 0 (a start-up transient), sampled at fs for ``periods`` periods after ``start`` s;
     noise: standard deviation relative to each channel's rms. Returns (t, f, x)."""
@@ -46,8 +46,8 @@ def mass_spring_damper(period, fs, periods, *, lines, noise=0.01, seed=0, variat
 
     def rhs(t, s):
         x, v = s
-        k = STIFFNESS * (1 + variation * np.cos(wp * t))
-        return [v, (f(t) - DAMPING * v - k * x) / MASS]
+        k = stiffness * (1 + variation * np.cos(wp * t))
+        return [v, (f(t) - damping * v - k * x) / mass]
 
     n = int(round(period * fs)) * periods
     t = start + np.arange(n) / fs

@@ -51,3 +51,40 @@ def test_demo_model_loads(demo_out):
 
     m = lptv.Model.load(demo_out / "model_wgtls.json")
     assert (m.na, m.nb, m.ka, m.kb) == (2, 1, 3, 3)
+
+
+def test_demo_report_shows_the_verdict_and_the_parameters_with_their_std(demo_out):
+    """The report, not only the terminal, says the verdict and lists every free parameter with
+    the true value (read here from lptv.examples.paper_model's arrays), both estimates and their
+    standard deviations; the SML errors in std units agree with the summary's share within 2 std."""
+    import re
+
+    import numpy as np
+
+    from lptv.examples import paper_model
+
+    html = (demo_out / "report.html").read_text()
+    assert re.search(r'<p class="verdict ok"><b>Verdict:</b> WGTLS: the model is consistent[^<]*SML: the model is '
+                     r"consistent", html)
+    head = "<tr><th>parameter</th><th>true</th><th>WGTLS</th><th>std</th><th>SML</th><th>std</th>"
+    assert head in html
+    table = html[html.index(head):]
+    table = table[:table.index("</table>")]
+    rows = re.findall(r"<tr>" + r"<td>([^<]*)</td>" * 7 + "</tr>", table)
+    m = paper_model()
+    truth = {}
+    for side, arr in (("a", m.a), ("b", m.b)):
+        K = (arr.shape[1] - 1) // 2
+        for n in range(arr.shape[0]):
+            truth[f"{side}{n}.re0"] = arr[n, K].real
+            for k in range(1, K + 1):
+                truth[f"{side}{n}.re{k}"], truth[f"{side}{n}.im{k}"] = arr[n, K + k].real, arr[n, K + k].imag
+    assert sorted(r[0] for r in rows) == sorted(truth)
+    free = [r for r in rows if r[3] != "normalised"]
+    assert len(free) == 34 and [r[0] for r in rows if r[3] == "normalised"] == ["a2.re0"]
+    for name, true, wg, s_wg, sm, s_sm, z in free:
+        assert float(true) == pytest.approx(truth[name], rel=1e-4, abs=1e-12)
+        assert float(s_wg) > 0 and float(s_sm) > 0
+        assert float(z) == pytest.approx((float(sm) - float(true)) / float(s_sm), abs=0.05)
+    s = json.loads((demo_out / "summary.json").read_text())
+    assert np.mean([abs(float(r[6])) <= 2.0 for r in free]) == pytest.approx(s["sml_within_2_sigma"], abs=1.5 / 34)
