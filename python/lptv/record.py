@@ -19,7 +19,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from . import _core
-from ._validate import as_counts, as_int, as_real_1d
+from ._validate import as_counts, as_int, as_positive_float, as_real_1d, as_seed
 from .model import Model
 from .record_verdict import RecordVerdict, record_verdict
 
@@ -68,7 +68,30 @@ class RecordResult:
     (:mod:`lptv.record_verdict`), which needs no noise level: behind :attr:`model_ok`."""
     warnings: Tuple[str, ...] = ()
     """What the fit warned about (also issued as warnings): no convergence, a noise level the
-    residual contradicts."""
+    residual contradicts, the bias a noisy input causes."""
+    input_noise_bias: Optional[np.ndarray] = None
+    """With ``input_noise_std``: the first-order bias of ``eta`` that the input's noise causes
+    (the output-error fit takes the input as exact), measured by refitting with that much more
+    noise added to the input (METHOD.md section 17, "A noisy input"); None otherwise."""
+    input_noise_spread: Optional[np.ndarray] = None
+    """The standard deviation of those refits' shifts per parameter (None without
+    ``input_noise_std``)."""
+
+    @property
+    def eta_corrected(self) -> np.ndarray:
+        """``eta`` less :attr:`input_noise_bias` (``eta`` itself without ``input_noise_std``)."""
+        return self.eta if self.input_noise_bias is None else self.eta - self.input_noise_bias
+
+    @property
+    def std_corrected(self) -> np.ndarray:
+        """The std of :attr:`eta_corrected`: ``parameter_std`` with the bias estimate's own
+        sampling variance (spread^2 / draws) added."""
+        if self.input_noise_bias is None:
+            return self.parameter_std
+        return np.sqrt(self.parameter_std ** 2 + self.input_noise_spread ** 2 / self.input_noise_draws)
+
+    input_noise_draws: int = 0
+    """The refits behind :attr:`input_noise_bias` (0 without ``input_noise_std``)."""
 
     @property
     def cost_ratio(self) -> float:
@@ -147,7 +170,8 @@ def local_polynomial_noise(U, Y, L, lines, *, branches: int, degree: int = 2, ha
 def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float, lines=None, transient: bool = True, noise="residual",
                     noise_width: int = 10, lpm_branches: Optional[int] = None, lpm_degree: int = 2,
                     max_iterations: int = 100, continuous: bool = False,
-                    transient_degree: Optional[int] = None) -> RecordResult:
+                    transient_degree: Optional[int] = None, input_noise_std: Optional[float] = None,
+                    input_noise_draws: int = 8, seed=None) -> RecordResult:
     """Identify an LPTV model from one record (not periodic, with a start-up transient).
 
     Parameters
@@ -200,6 +224,21 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
     transient_degree : int, optional
         Continuous time: d, at least n - 1; default n + 1 (n = max(na, nb)). Not for
         discrete time.
+    input_noise_std : float, optional
+        The standard deviation of the input's measurement noise (white, in the units of u), when
+        it is known (a sensor's specification, a record at rest). The fit takes the input as
+        exact, so a noisy input biases it (towards a smaller gain, about the input's
+        noise-to-signal power ratio); with this the bias is measured to first order by refitting
+        with as much noise again added to the input, ``input_noise_draws`` times, and reported
+        (``input_noise_bias``, in the warnings in std units) and removed in ``eta_corrected``,
+        whose std ``std_corrected`` is. Measured (bench/HISTORY.md, "One record with a noisy
+        input"): at 5 % input noise the corrected estimates' mean error within 0.15 std (the raw
+        ones' up to 0.55), their 95 % intervals covering 93.4 % pooled (89.5-97 % per parameter).
+    input_noise_draws : int
+        Refits behind the bias (each one fit's cost).
+    seed : int or numpy Generator, optional
+        The draws' random numbers (in a simulation study, not the stream that made the record's
+        input: draws equal to the input's own samples are not independent of it).
 
     Examples
     --------
@@ -315,6 +354,29 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
             said.append(f"identify_record: the local polynomial method's noise level is {1 / ratio:.3g} times "
                         "what the fit's residual shows: it overestimates the noise where the HTF's branches "
                         "decay slowly (raise lpm_branches), and weighs the lines wrongly; use noise='residual'")
+    bias = spread = None
+    draws = 0
+    if input_noise_std is not None:
+        input_noise_std = as_positive_float(input_noise_std, "input_noise_std")
+        draws = as_int(input_noise_draws, "input_noise_draws", minimum=2, maximum=1000)
+        rng = as_seed(seed)
+        shifts = []
+        for _ in range(draws):
+            ud = u + input_noise_std * rng.standard_normal(u.size)
+            Ud = np.fft.fft(ud) / N
+            fd = _core.fit_record(par, Ud, Y, L, [int(v) for v in lines], transient=bool(transient),
+                                  noise_var=var, noise_width=noise_width, max_iterations=max_iterations,
+                                  ts=float(ts), transient_degree=t_degree)
+            shifts.append(np.asarray(fd.eta) - np.asarray(fit.eta))
+        shifts = np.array(shifts)
+        bias, spread = shifts.mean(axis=0), shifts.std(axis=0, ddof=1)
+        std = np.sqrt(np.diag(cov_eta))
+        free = std > 0
+        worst = int(np.argmax(np.where(free, np.abs(bias) / np.where(free, std, 1), -1)))
+        snr = 10 * np.log10(np.var(u) / input_noise_std ** 2)
+        said.append(f"identify_record: the input's noise (std {input_noise_std:.3g}, SNR {snr:.1f} dB) biases the "
+                    f"output-error estimate by up to {abs(bias[worst]) / std[worst]:.2g} std ({par.eta_names[worst]}); "
+                    "eta_corrected removes it (std_corrected)")
     for msg in said:
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
     return RecordResult(
@@ -323,4 +385,5 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         transient_std=np.asarray(fit.transient_std), periods=L, lines=lines, noise_var=var,
         noise_dof=int(noise_dof), Y=Y[lines], Y_fit=Y_fit, cost=float(fit.cost),
         dof=int(fit.dof), converged=bool(fit.converged), iterations=int(fit.iterations),
-        record_verdict=verdict, warnings=tuple(said))
+        record_verdict=verdict, warnings=tuple(said), input_noise_bias=bias, input_noise_spread=spread,
+        input_noise_draws=draws)

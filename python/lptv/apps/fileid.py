@@ -111,6 +111,9 @@ def add_parser(sub):
                    help="the file is one record that does not repeat (a start-up transient, an input that is "
                    "not periodic): fit it whole with its transient (lptv.identify_record); needs --period "
                    "or --w0 and the sampling frequency")
+    p.add_argument("--input-noise", type=float, metavar="STD",
+                   help="with --one-record: the std of the input's measurement noise, when known; its bias "
+                   "is measured and removed (the corrected parameters are printed and saved)")
     p.add_argument("--discrete", action="store_true",
                    help="identify a discrete-time model (in the shift z) with the sample period 1 / fs")
     p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "

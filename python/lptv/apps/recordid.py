@@ -74,8 +74,12 @@ def run(args, names=None) -> int:
         ts = args.ts if args.ts is not None else 1.0 / meas.fs
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
+            noise_std = getattr(args, "input_noise", None)
+            if noise_std is not None and not (np.isfinite(noise_std) and noise_std > 0):
+                raise FileError(f"--input-noise must be a positive number, got {noise_std}")
             res = identify_record(u, y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=2 * np.pi / period, ts=ts,
-                                  continuous=not discrete, max_iterations=max(args.max_iter, 1))
+                                  continuous=not discrete, max_iterations=max(args.max_iter, 1),
+                                  input_noise_std=noise_std, seed=0)
     except NumericalError as e:
         return _fail(src, e, status=1, names=names)
     except (FileError, ValueError) as e:
@@ -89,7 +93,10 @@ def run(args, names=None) -> int:
           + (f", {meas.trimmed} samples dropped at the start" if meas.trimmed else "") + ")")
     print(f"  verdict: {res.verdict}")
     width = max(len(n) for n in res.eta_names)
-    for name, v, s in zip(res.eta_names, res.eta, res.parameter_std):
+    corrected = res.input_noise_bias is not None
+    if corrected:
+        print("  parameters corrected for the input's noise (the output-error estimate in summary.json):")
+    for name, v, s in zip(res.eta_names, res.eta_corrected, res.std_corrected):
         print(f"  {name:<{width}}  {v: .6g}" + (f" +- {s:.3g}" if s > 0 else "  (normalisation)"))
     for msg in list(res.warnings) + extra:
         print(f"  warning: {msg}")
@@ -103,6 +110,9 @@ def run(args, names=None) -> int:
                          "p_value": res.record_verdict.p_value, "alpha": res.record_verdict.alpha},
         "parameters": {n: {"value": float(v), "std": float(s)}
                        for n, v, s in zip(res.eta_names, res.eta, res.parameter_std)},
+        "parameters_corrected_for_input_noise": None if not corrected else {
+            n: {"value": float(v), "std": float(s), "bias": float(b)}
+            for n, v, s, b in zip(res.eta_names, res.eta_corrected, res.std_corrected, res.input_noise_bias)},
         "warnings": list(res.warnings) + extra})
     wrote = "model.json, summary.json"
     try:
