@@ -34,8 +34,11 @@ def _figure(figsize=(6.4, 4.0), rows: int = 1, cols: int = 1, *, sharex=False, w
     fig.subplots_adjust(left=m["left"] / w, right=1 - m["right"] / w, bottom=m["bottom"] / h,
                         top=1 - m["top"] / h, hspace=m["hspace"] / max(ax_h, 0.1),
                         wspace=m["wspace"] / max(ax_w, 0.1))
-    return fig, fig.subplots(rows, cols, sharex=sharex, squeeze=False, width_ratios=width_ratios,
-                             height_ratios=height_ratios)
+    axes = fig.subplots(rows, cols, sharex=sharex, squeeze=False, width_ratios=width_ratios,
+                        height_ratios=height_ratios)
+    for ax in axes.flat:      # at most 6 ticks a side: each tick is a text to lay out and draw
+        ax.locator_params(nbins=5)
+    return fig, axes
 
 
 def _axes(ax, figsize=(6.4, 4.0)):
@@ -937,7 +940,7 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
         ax_m.set_title("Bode plot: the measured Y/U and the identified model", fontsize="medium")
     else:
         ax_m.set_title("Y/U on the excited lines: measured, and predicted by the model", fontsize="medium")
-        _branches_panel(axes[2, 0], res, sets, scale, min(n_points, 120))
+        _branches_panel(axes[2, 0], res, sets, scale, min(n_points, 80))
     return fig
 
 

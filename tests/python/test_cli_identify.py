@@ -100,7 +100,7 @@ def test_round_trip_gives_the_python_api_model(fmt, paper, tmp_path, capsys):
     assert summary["fraction_above_0db"] == pytest.approx(ref.fraction_above_0db, abs=1e-12)
     assert summary["residue_ok"] == ref.residue_ok
     page = (out / "report.html").read_text()
-    for png in ("normalized_residue", "frozen_poles_zeros", "output_spectrum", "coefficients"):
+    for png in ("bode", "normalized_residue", "residue_tests", "frozen_poles_zeros", "coefficients"):
         assert f'alt="{png}.png"' in page and (out / f"{png}.png").stat().st_size > 1000
 
 

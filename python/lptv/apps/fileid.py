@@ -419,7 +419,7 @@ def _report(src, meas, res, Y_pred, summary, known=None) -> Report:
     from lptv.apps.report import coefficient_figure, parameter_section, residue_tests_section
     from lptv.apps.units import channel_unit
 
-    model, d, rows = res.model, res.data, res.lines
+    model, rows = res.model, res.lines
     P, N = meas.u.shape
     lo, hi = res.fraction_band
     u_unit, y_unit = channel_unit(meas.input), channel_unit(meas.output)
@@ -459,14 +459,6 @@ def _report(src, meas, res, Y_pred, summary, known=None) -> Report:
     except (ValueError, NumericalError, np.linalg.LinAlgError):
         pass
     gap = summary["prediction_error_vs_noise_db"]
-    ax = plots.model_fit(rows, d.Y[rows], Y_pred[rows], np.sqrt(d.varY[rows]), w0=model.w0)
-    rep.figure(ax.figure, "output_spectrum.png",
-               "Measured output spectrum (dots) on every line of the fit, the output the model predicts from the "
-               "measured input (open circles), their difference and the noise standard deviation of the mean of "
-               f"the {P} periods (one period's is sqrt({P}) larger). "
-               + (f"The difference is on average {gap:+.1f} dB from the noise level; a good model keeps "
-                  "it near the noise (the measured input is noisy too), far below |Y| on the excited lines."
-                  if gap is not None else ""))
 
     rep.heading("The verdict's evidence")
     vlo, vhi = res.verdict_band
