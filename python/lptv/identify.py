@@ -11,7 +11,7 @@ from . import _core
 from .data import FrequencyData, experiments_of, frequency_data_of
 from .floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
 from .model import Model
-from ._validate import as_counts, as_float, as_int, as_lines
+from ._validate import INT_MAX, as_counts, as_float, as_int, as_lines
 from .result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
@@ -65,15 +65,21 @@ def _rows(lines):
 
 def _below_nyquist(lines, max_line):
     """Lines above the data's highest line (N/2, the Nyquist line) named as such, before a long
-    list of them is converted (``lines=range(1, 10**8)`` on 2048 samples per period)."""
-    if lines is None or isinstance(lines, str):
+    range or array of them is converted (``lines=range(1, 10**8)`` on 2048 samples per period).
+    Only a range or an integer array within the core's int is looked at here: anything else
+    (floats, huge or negative values, other types) is as_lines's to name."""
+    if isinstance(lines, range):
+        top = (lines[-1] if lines.step > 0 else lines[0]) if len(lines) else None
+    elif isinstance(lines, np.ndarray) and lines.dtype.kind in "iu" and lines.size:
+        top, low = int(lines.max()), int(lines.min())
+    elif isinstance(lines, (list, tuple)) and lines and all(type(v) is int for v in lines):
+        top, low = max(lines), min(lines)
+    else:
         return
-    try:
-        top = np.max(np.asarray(lines)) if np.size(lines) else None
-    except (TypeError, ValueError):
-        return                       # not numbers: as_lines names the problem
-    if top is not None and np.isreal(top) and np.isfinite(top) and top > max_line:
-        raise ValueError(f"lines: line {top:.0f} lies above the Nyquist line {max_line} of the data "
+    if isinstance(lines, range):
+        low = min(lines[0], lines[-1]) if len(lines) else 0
+    if top is not None and max_line < top <= INT_MAX and low >= 0:
+        raise ValueError(f"lines: line {top} lies above the Nyquist line {max_line} of the data "
                          f"({2 * max_line} or {2 * max_line + 1} samples per period: line N/2 is half the "
                          "sampling frequency, the highest a period holds)")
 
