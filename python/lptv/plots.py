@@ -536,7 +536,9 @@ def residue_tests(res, *, fig=None):
     fig.legend(handles=[Line2D([], [], color="k", ls="--", lw=1.1,
                                label=f"each test's threshold (Holm, overall {100 * tests.alpha:g} %)"),
                         Patch(color="C0", label="not rejected"), Patch(color="C3", label="rejects")],
-               loc="upper center", ncol=3, fontsize="small", frameon=False, borderaxespad=0.2)
+               # a constrained layout (a figure passed in) makes room above the axes for it
+               loc="outside upper center" if type(fig.get_layout_engine()).__name__ == "ConstrainedLayoutEngine"
+               else "upper center", ncol=3, fontsize="small", frameon=False, borderaxespad=0.2)
     return fig
 
 
@@ -935,7 +937,15 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
     ax_m.set_ylabel("|Y/U| (dB)")
     ax_p.set_ylabel("phase of Y/U (deg)")
     axes[-1, 0].set_xlabel("frequency (Hz)" if hz else "angular frequency (rad/s)")
-    ax_m.legend(fontsize="small" if len(sets) < 3 else "x-small", ncol=1 if len(sets) < 3 else 2)
+    if len(sets) < 3:
+        ax_m.legend(fontsize="small")
+    else:   # many experiments: one entry for their points (the containers keep their own labels)
+        handles, labels = ax_m.get_legend_handles_labels()
+        keep = [i for i, lab in enumerate(labels) if not lab.startswith("experiment ")]
+        first = labels.index(sets[0][0])
+        ax_m.legend([handles[i] for i in keep] + [handles[first]],
+                    [labels[i] for i in keep] + [f"each of the {len(sets)} experiments' Y/U (+-2 std), "
+                                                 "a marker each"], fontsize="small")
     if lti:
         ax_m.set_title("Bode plot: the measured Y/U and the identified model", fontsize="medium")
     else:

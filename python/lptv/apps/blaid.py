@@ -247,10 +247,6 @@ def _report(src, meas, dist, res, summary, known=None) -> Report:
            "which holds whatever the distortion's correlation across lines, corrected for realisations "
            "of unequal information and scaled to the t quantile of its degrees of freedom ("
            + _dof_range(res) + ")." if summary.get("covariance") == "realisations" else ""))
-    scale = summary.get("scale")
-    u_unit, y_unit = units.channel_unit(meas.input), units.channel_unit(meas.output)
-    physical = parameter_section(rep, res, scale=(scale["coefficient"], scale["value"]) if scale else None,
-                                 known=known, u_unit=u_unit, y_unit=y_unit)
     if res.lack_of_fit is not None:
         rep.figure(plots.lack_of_fit(res.lack_of_fit, w0=model.w0).figure, "lack_of_fit.png",
                    "The verdict's test: on each judged output line the model's prediction against the "
@@ -266,6 +262,12 @@ def _report(src, meas, dist, res, summary, known=None) -> Report:
                   "input over that input (Y/U on a line holds every branch's share, not G_0 alone); below, "
                   "the model's HTF branches G_k with their nonparametric estimates where a realisation "
                   "separates them (lptv.htf_estimate; entries its neighbours' far branches overlap left out)."))
+    # the parameters after the figures: a BLA's model is often large (34 parameters here, 100 rows
+    # with their amplitudes and phases)
+    scale = summary.get("scale")
+    u_unit, y_unit = units.channel_unit(meas.input), units.channel_unit(meas.output)
+    physical = parameter_section(rep, res, scale=(scale["coefficient"], scale["value"]) if scale else None,
+                                 known=known, u_unit=u_unit, y_unit=y_unit)
     model_figures(rep, res, physical=physical, u_unit=u_unit, y_unit=y_unit)
     rep.preformatted(res.summary())
     return rep
