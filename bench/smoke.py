@@ -58,6 +58,7 @@ SMOKE = {
     "bench_record_core.py": ["1", "4"],
     "bench_record_verdict.py": ["3", "2"],
     "bench_record_input_noise.py": ["3"],
+    "bench_report_time.py": ["--runs", "1"],
     "bench_select.py": ["1", "--small"],
     "bench_select_time.py": ["1"],
     "bench_simulate.py": ["300", "30"],                # L = 30 and 300

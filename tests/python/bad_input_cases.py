@@ -1066,6 +1066,9 @@ def cli_cases():
     for v in ("abc", "b0", "b0=0", "b0=nan", "b9=1", "q1=1", "b0=x"):
         add(f"identify-scale-{v}", ok + ("--scale", v), "--scale")
     add("identify-scale-with-known", ok + ("--scale", "b0=1", "--known", "b0=1"), "--scale")
+    for v in ("nan", "inf", "-1", "0", "abc"):
+        add(f"identify-input-noise-{v}", ok + ("--one-record", "--period", "1", "--input-noise", v), "--input-noise")
+    add("identify-input-noise-periods", ok + ("--input-noise", "0.1"), "--input-noise")
     add("identify-method-bogus", ok + ("--method", "ml"), "--method")
     add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
     add("identify-noise-bogus", ok + ("--noise", "smooth"), "--noise")

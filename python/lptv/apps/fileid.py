@@ -254,6 +254,10 @@ def run(args) -> int:
         print("lptv identify: error: --resume applies to a batch of files (several files, --workers or "
               "--scheduler), not to one record or --joint", file=sys.stderr)
         return 2
+    if getattr(args, "input_noise", None) is not None and not getattr(args, "one_record", False):
+        print("lptv identify: error: --input-noise is for --one-record (records of periods measure the input's "
+              "noise themselves)", file=sys.stderr)
+        return 2
     if getattr(args, "one_record", False):
         if args.joint or len(args.files) > 1 or args.workers is not None or args.scheduler is not None:
             print("lptv identify: error: --one-record takes one file (not several files, --joint, --workers or "

@@ -55,6 +55,9 @@ def run(args, names=None) -> int:
     except OSError as e:
         return _fail(e.filename or args.out, e.strerror or e)
     try:
+        noise_std = getattr(args, "input_noise", None)
+        if noise_std is not None and not (np.isfinite(noise_std) and noise_std > 0):
+            raise FileError(f"--input-noise must be a positive number (the input noise's std), got {noise_std}")
         for opt in ("na", "nb", "max_iter"):
             integer(getattr(args, opt), "--" + opt.replace("_", "-"))
         if args.max_iter < 1:
@@ -74,9 +77,6 @@ def run(args, names=None) -> int:
         ts = args.ts if args.ts is not None else 1.0 / meas.fs
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            noise_std = getattr(args, "input_noise", None)
-            if noise_std is not None and not (np.isfinite(noise_std) and noise_std > 0):
-                raise FileError(f"--input-noise must be a positive number, got {noise_std}")
             res = identify_record(u, y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=2 * np.pi / period, ts=ts,
                                   continuous=not discrete, max_iterations=max(args.max_iter, 1),
                                   input_noise_std=noise_std, seed=0)
