@@ -1,5 +1,6 @@
 """The package's shape (DESIGN.md): no module imports another that imports it back, at any level
-(a lazy import inside a function counts: it is a circle all the same)."""
+(a lazy import inside a function counts: it is a circle all the same), and no module is longer
+than one sitting's reading (800 lines)."""
 import ast
 from pathlib import Path
 
@@ -77,3 +78,11 @@ def test_the_documents_name_no_file_outside_the_repository():
     found = [f"{p.relative_to(root)}:{i}: {line.strip()}" for p in files
              for i, line in enumerate(p.read_text().splitlines(), 1) if any(s in line for s in OUTSIDE)]
     assert not found, "\n".join(found)
+
+
+MAX_LINES = 800
+
+
+def test_no_module_is_longer_than_one_sitting():
+    long = {m: n for m, p in _modules().items() if (n := len(p.read_text().splitlines())) > MAX_LINES}
+    assert not long, long
