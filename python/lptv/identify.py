@@ -418,12 +418,12 @@ def realisation_covariance(estimates, dof=None, ratio=None) -> np.ndarray:
     n = est.shape[1]
     s = np.ones(n)
     if dof is not None:
-        from scipy import stats
+        from ._dist import t_ppf
 
         nu = np.asarray(dof, dtype=float)
         if nu.shape != (n,) or not np.all(np.isfinite(nu)) or np.any(nu < 1) or np.any(nu > E - 1):
             raise ValueError(f"dof must give one value in [1, {E - 1}] per parameter ({n}), got {dof!r}")
-        s = s * stats.t.ppf(0.975, nu) / stats.t.ppf(0.975, E - 1)
+        s = s * t_ppf(0.975, nu) / t_ppf(0.975, E - 1)
     if ratio is not None:
         q = np.asarray(ratio, dtype=float)
         if q.shape != (n,) or not np.all(np.isfinite(q)) or np.any(q <= 0):

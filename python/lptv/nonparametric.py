@@ -172,7 +172,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     >>> est.significant().tolist()        # the modulation reaches one line each side
     [-1, 0, 1]
     """
-    from scipy import stats
+    from ._dist import gamma_sf
 
     method = as_str(method, "method", ("ratio", "lpm"))
     dof = None
@@ -199,7 +199,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     # of freedom (P - 1 for the means of periods; the LPM fit's residual count minus its unknowns)
     q = dof if dof is not None else (P - 1 if P and P > 1 else 0)
     scale = q / (q - 1) if q > 1 else 1.0
-    p = stats.gamma.sf(stat / scale, n)
+    p = gamma_sf(stat / scale, n)
     lines = np.asarray(h.lines)
     G, std = np.asarray(h.G), np.sqrt(np.asarray(h.variance))
     leak = _leakage(G, std, lines, h.branches, np.abs(np.asarray(data.U)[lines]))

@@ -48,12 +48,11 @@ def _parse(name):
 
 
 def _z(level):
-    from scipy.stats import norm
-
+    from ._dist import norm_ppf
     from ._validate import as_float
 
     level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
-    return float(norm.ppf(0.5 + level / 2.0))
+    return float(norm_ppf(0.5 + level / 2.0))
 
 
 def parameter_table(obj, level: float = 0.95) -> List[dict]:

@@ -56,7 +56,7 @@ def _window(n_regressors: int) -> int:
 def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA) -> RecordVerdict:
     """The verdict of a one-record fit from the record's full DFT ``U`` (N lines), the
     normalised residual on ``lines`` and the model's largest harmonic count ``kmax``."""
-    from scipy import stats
+    from ._dist import f_sf
 
     N = U.size
     lines = np.asarray(lines)
@@ -104,8 +104,8 @@ def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA) -> RecordV
                              ("the verdict needs at least one window of "
                               f"{W} lines where the input is nonzero",))
     F = (s_expl / d_expl) / (s_rest / d_rest)
-    p = float(stats.f.sf(F, d_expl, d_rest))
-    per = [float(stats.f.sf((drop[j] / (2 * seen[j])) / (s_rest / d_rest), 2 * seen[j], d_rest)) if seen[j] else np.nan
+    p = float(f_sf(F, d_expl, d_rest))
+    per = [float(f_sf((drop[j] / (2 * seen[j])) / (s_rest / d_rest), 2 * seen[j], d_rest)) if seen[j] else np.nan
            for j in range(q)]
     errors = []
     if p < alpha:

@@ -281,7 +281,7 @@ def _pooled(var, P):
     degrees of freedom of a scaled chi-square with the median's variance, 1 / (4 w f(m)^2)
     relative to m^2 (f the density at the median m)."""
     from scipy.ndimage import median_filter
-    from scipy.stats import gamma
+    from ._dist import gamma_median, gamma_pdf
 
     n = var.size
     w = min(2 * NOISE_HALF_WINDOW + 1, n)
@@ -292,9 +292,8 @@ def _pooled(var, P):
         med[n - h:] = np.median(var[n - w:])
     else:
         med[:] = np.median(var)
-    law = gamma(P - 1, scale=1.0 / (P - 1))
-    m = law.median()
-    nu = 4.0 * w * (m * law.pdf(m)) ** 2
+    m = gamma_median(P - 1, 1.0 / (P - 1))
+    nu = 4.0 * w * (m * gamma_pdf(m, P - 1, 1.0 / (P - 1))) ** 2
     return med / m, nu
 
 

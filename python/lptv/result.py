@@ -142,14 +142,14 @@ class IdentificationResult:
         >>> bool(lo < 2.0 < hi)
         True
         """
-        from scipy.stats import norm
+        from ._dist import norm_ppf
 
         level = as_positive_float(level, "level")
         if not 0.0 < level < 1.0:
             raise ValueError(f"level must be in (0, 1), got {level!r}")
         if self.covariance is None:
             raise ValueError(self._no_covariance()[0])
-        half = norm.ppf(0.5 + level / 2.0) * self.parameter_std
+        half = norm_ppf(0.5 + level / 2.0) * self.parameter_std
         return np.column_stack([self.eta - half, self.eta + half])
 
     def _no_covariance(self) -> Tuple[str, str]:

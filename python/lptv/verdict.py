@@ -111,11 +111,11 @@ class ResidueTests:
 
 def _signal_lines(d, P: int) -> np.ndarray:
     """Lines 0..max_line where the output or the input stands above its noise."""
-    from scipy import stats
+    from . import _dist as stats_
 
     if P >= 2:
         nu = 2 * (P - 1)
-        q = stats.f.isf(SIGNAL_FALSE_RATE, 2, nu)
+        q = stats_.f_isf(SIGNAL_FALSE_RATE, 2, nu)
     else:
         q = -np.log(SIGNAL_FALSE_RATE)
     out = np.zeros(d.max_line + 1, bool)
@@ -138,7 +138,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     """The verdict's tests of an identification result, or None when they cannot be formed
     (no data kept, no noise, no rows). ``structure`` is the core's Structure of the fit;
     ``excited`` the excited lines of each experiment (default: ``lptv.excited_lines``)."""
-    from scipy import stats
+    from . import _dist as stats_
     from scipy.linalg import block_diag
 
     datas = list(res.experiments) if res.experiments else ([res.data] if res.data is not None else [])
@@ -250,8 +250,8 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     shrink = np.clip(sig2 / v, 0.05, None)
     z = np.abs(np.asarray(res.residue)[order]) ** 2 / v / shrink
     nu = np.concatenate(nus)
-    u = np.where(np.isfinite(nu), stats.f.cdf(z, 2, np.where(np.isfinite(nu), nu, 1.0)), -np.expm1(-z))
-    score = stats.norm.ppf(np.clip(u, 1e-300, 1 - 1e-16))
+    u = np.where(np.isfinite(nu), stats_.f_cdf(z, 2, np.where(np.isfinite(nu), nu, 1.0)), -np.expm1(-z))
+    score = stats_.norm_ppf(np.clip(u, 1e-300, 1 - 1e-16))
     # Correlation of the rows' |e|^2 (Gaussian): ||C_ll'||_F^2 / (||C_ll||_F ||C_l'l'||_F).
     F2 = np.einsum("iajb,iajb->ij", blocks, blocks)
     dF = np.sqrt(np.diag(F2))
@@ -279,12 +279,12 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         return float(s / np.sqrt(corr[np.ix_(mask, mask)].sum()))
 
     t_all = stat(judged)
-    tests.append(("rows with signal", judged, t_all, float(2 * stats.norm.sf(abs(t_all)))))
+    tests.append(("rows with signal", judged, t_all, float(2 * stats_.norm_sf(abs(t_all)))))
     for g in np.unique(groups[groups >= 0]):
         mask = judged & (groups == g)
         if mask.any() and not np.array_equal(mask, judged):
             t = stat(mask)
-            tests.append((f"rows {g} line{'' if g == 1 else 's'} from the nearest excited line", mask, t, float(stats.norm.sf(t))))
+            tests.append((f"rows {g} line{'' if g == 1 else 's'} from the nearest excited line", mask, t, float(stats_.norm_sf(t))))
     kinds = ["residues"] * len(tests)
     # Score tests: one more harmonic on each coefficient (METHOD.md section 7).
     for x, parts in score_parts.items():
@@ -378,7 +378,7 @@ def _score_test(parts, par_x, name):
     2 F(2, nu_eff) with nu_eff the rows' Satterthwaite degrees of freedom. Returns (F value,
     p-value), or None (a row with fewer than 6 degrees of freedom: 2 or 3 periods; nothing to
     test)."""
-    from scipy import stats
+    from . import _dist as stats_
 
     if not parts:
         return None
@@ -410,8 +410,8 @@ def _score_test(parts, par_x, name):
     Fval = LM / (2.0 * kappa)
     if fin.any():
         nu_eff = c.sum() ** 2 / np.sum(c[fin] ** 2 / nu[fin])
-        return Fval, float(stats.f.sf(Fval, 2, nu_eff))
-    return Fval, float(stats.chi2.sf(LM, 2))
+        return Fval, float(stats_.f_sf(Fval, 2, nu_eff))
+    return Fval, float(stats_.chi2_sf(LM, 2))
 
 
 def _offset_groups(rows: np.ndarray, excited: np.ndarray) -> np.ndarray:
