@@ -135,6 +135,8 @@ def test_the_command_line_route_writes_the_model_and_exits_by_the_verdict(tmp_pa
     assert m.ts is None and m.na == 2
     # the stiffness's variation: a0 = k0 (1 + 0.1 cos) / m, its first harmonic 0.05 k0 = 0.2
     assert abs(m.a[0, m.ka + 1]) == pytest.approx(0.2, rel=0.1)
+    assert cli.main(base + ["--ka", "1,0,0", "--no-report", "--out", str(tmp_path / "quick")]) == 0
+    assert (tmp_path / "quick" / "model.json").exists() and not (tmp_path / "quick" / "report.html").exists()
     assert cli.main(base + ["--ka", "0", "--out", str(tmp_path / "lti")]) == 3
     assert "MODEL ERRORS" in capsys.readouterr().out
     no_period = [a for a in base if a not in ("--period", "10")]

@@ -115,11 +115,14 @@ def run(args, names=None) -> int:
             for n, v, s, b in zip(res.eta_names, res.eta_corrected, res.std_corrected, res.input_noise_bias)},
         "warnings": list(res.warnings) + extra})
     wrote = "model.json, summary.json"
-    try:
-        _report(res, src, L, N0, meas.fs, discrete).write(out)
-        wrote += ", report.html"
-    except ImportError:
-        wrote += " (no report.html: it needs matplotlib, pip install 'lptv[plots]')"
+    if getattr(args, "no_report", False):
+        pass
+    else:
+        try:
+            _report(res, src, L, N0, meas.fs, discrete).write(out)
+            wrote += ", report.html"
+        except ImportError:
+            wrote += " (no report.html: it needs matplotlib, pip install 'lptv[plots]')"
     print(f"wrote {out}/: {wrote}")
     return 0 if res.model_ok else MODEL_ERRORS
 
