@@ -115,9 +115,7 @@ def run(args, names=None) -> int:
             for n, v, s, b in zip(res.eta_names, res.eta_corrected, res.std_corrected, res.input_noise_bias)},
         "warnings": list(res.warnings) + extra})
     wrote = "model.json, summary.json"
-    if getattr(args, "no_report", False):
-        pass
-    else:
+    if not getattr(args, "no_report", False):
         try:
             _report(res, src, L, N0, meas.fs, discrete).write(out)
             wrote += ", report.html"
