@@ -84,6 +84,68 @@ void window_sums(const Eigen::VectorXd& x, const std::vector<char>& keep, long l
   }
 }
 
+// The local log-quadratic trend that corrects the neighbours' mean for the spectrum's shape is
+// fitted over +-kShapeWidth * W lines (the reference's SHAPE_WIDTH).
+constexpr long long kShapeWidth = 2;
+
+// Per position i: k[i], the factor that turns the arithmetic mean of the neighbours' variances
+// (|j - i| <= W, j != i, keep[j]) into the trend's value at i, and v[i], the variance of log
+// k[i]. The trend z_j = alpha + beta x + c x^2 (x = j - i) is fitted by least squares to the
+// log variances z over |x| <= kShapeWidth W (j != i, ok[j]); k = 1 / mean_j exp(beta x_j +
+// c x_j^2 - q_j / 2), q_j the fitted shape's variance at x_j. Fewer than W points on either side
+// of i within the fit's window, or a singular fit: k = 1, v = 0. The reference's _shape.
+void shape_factors(const Eigen::VectorXd& z, const std::vector<char>& ok, const std::vector<char>& keep,
+                   long long W, double var_log, Eigen::VectorXd& k, Eigen::VectorXd& v) {
+  const Eigen::Index m = z.size();
+  const long long S = kShapeWidth * W;
+  k = Eigen::VectorXd::Ones(m);
+  v = Eigen::VectorXd::Zero(m);
+  std::vector<long long> left(m, 0), right(m, 0);
+  for (long long x = 1; x <= S; ++x)
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (i - x >= 0 && ok[i - x]) ++left[i];
+      if (i + x < m && ok[i + x]) ++right[i];
+    }
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (left[i] < W || right[i] < W) continue;
+    double C[5] = {0, 0, 0, 0, 0}, T[3] = {0, 0, 0};
+    for (long long x = -S; x <= S; ++x) {
+      const long long j = i + x;
+      if (x == 0 || j < 0 || j >= m || !ok[j]) continue;
+      const double xf = static_cast<double>(x);
+      double p = 1.0;
+      for (int q = 0; q < 5; ++q, p *= xf) {
+        C[q] += p;
+        if (q < 3) T[q] += z[j] * p;
+      }
+    }
+    Eigen::Matrix3d A;
+    A << C[0], C[1], C[2], C[1], C[2], C[3], C[2], C[3], C[4];
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(A);
+    if (!lu.isInvertible()) continue;
+    const Eigen::Matrix3d Ai = lu.inverse();
+    if (!Ai.allFinite()) continue;
+    const Eigen::Vector3d theta = Ai * Eigen::Vector3d(T[0], T[1], T[2]);
+    const Eigen::Matrix2d V = var_log * Ai.bottomRightCorner<2, 2>();
+    double e_sum = 0.0, ex = 0.0, ex2 = 0.0;
+    long long count = 0;
+    for (long long x = -W; x <= W; ++x) {
+      const long long j = i + x;
+      if (x == 0 || j < 0 || j >= m || !keep[j]) continue;
+      const Eigen::Vector2d X(static_cast<double>(x), static_cast<double>(x) * x);
+      const double e = std::exp(X.dot(theta.tail<2>()) - 0.5 * X.dot(V * X));
+      e_sum += e;
+      ex += e * X[0];
+      ex2 += e * X[1];
+      ++count;
+    }
+    if (count == 0) continue;
+    k[i] = static_cast<double>(count) / e_sum;
+    const Eigen::Vector2d a(ex / e_sum, ex2 / e_sum);
+    v[i] = a.dot(V * a);
+  }
+}
+
 }  // namespace
 
 double digamma(double x) {
@@ -270,6 +332,32 @@ ModeratedNoise moderated_noise(const FrequencyData& data, int half_width) {
   for (Eigen::Index i = 0; i < m; ++i) keep[i] = !outlier[i];
   const double scale = std::max(d0 - 2.0, 0.0) / d0;
   const double w = d / (d + d0);
+  // The neighbours' arithmetic mean, turned by each channel's shape factor into the trend's
+  // value at the line (a log spectrum that slopes or bends within the window biases the mean).
+  Eigen::VectorXd kch[2], vch[2];
+  {
+    int c = 0;
+    for (const Eigen::VectorXd* src : {&data.varU, &data.varY}) {
+      const Eigen::VectorXd vi = src->segment(1, m);
+      std::vector<char> okv(m);
+      Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
+      long long count = 0;
+      for (Eigen::Index i = 0; i < m; ++i) {
+        okv[i] = vi[i] > 0 && keep[i];
+        if (okv[i]) {
+          z[i] = std::log(vi[i]) - mean_log;
+          ++count;
+        }
+      }
+      if (count >= 3 * W) {
+        shape_factors(z, okv, keep, W, var_log, kch[c], vch[c]);
+      } else {
+        kch[c] = Eigen::VectorXd::Ones(m);
+        vch[c] = Eigen::VectorXd::Zero(m);
+      }
+      ++c;
+    }
+  }
   FrequencyData& mod = out.data;
   Eigen::VectorXd su, sy, sr, si;
   window_sums(data.varU.segment(1, m), keep, W, su, n);
@@ -283,12 +371,15 @@ ModeratedNoise moderated_noise(const FrequencyData& data, int half_width) {
     if (keep[i]) out.neighbour[l] = true;
     if (!keep[i] || n[i] <= 0) continue;
     const double c = (1.0 - w) * scale;
-    mod.varU[l] = w * data.varU[l] + c * su[i] / n[i];
-    mod.varY[l] = w * data.varY[l] + c * sy[i] / n[i];
-    mod.covYU[l] = w * data.covYU[l] + c * std::complex<double>(sr[i], si[i]) / static_cast<double>(n[i]);
-    // Satterthwaite: relative variance 2/d of the own part, 2/d0 + 2/(n d) of the prior's.
+    const double ku = kch[0][i], ky = kch[1][i], kc = std::sqrt(ku * ky);
+    mod.varU[l] = w * data.varU[l] + c * ku * su[i] / n[i];
+    mod.varY[l] = w * data.varY[l] + c * ky * sy[i] / n[i];
+    mod.covYU[l] = w * data.covYU[l] + c * kc * std::complex<double>(sr[i], si[i]) / static_cast<double>(n[i]);
+    // Satterthwaite: relative variance 2/d of the own part, 2/d0 + 2/(n d) + v of the prior's
+    // (v the variance of the log shape factor).
     const double nn = n[i];
-    out.dof[l] = (d + d0) * (d + d0) / (d + d0 + d0 * d0 / (nn * d));
+    const double vk = std::max(vch[0][i], vch[1][i]);
+    out.dof[l] = (d + d0) * (d + d0) / (d + d0 + d0 * d0 * (1.0 / (nn * d) + vk / 2.0));
     out.own_weight[l] = w;
   }
   for (Eigen::Index l = 0; l <= L; ++l) {

@@ -15,6 +15,11 @@ from ._validate import INT_MAX, as_counts, as_float, as_int, as_lines
 from .result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
+NOISES = ("auto", "sample", "moderated")
+# noise='auto' moderates from this many periods: below it the lines that keep their own variance
+# (lines 0 and Lmax, outliers) have 1-4 degrees of freedom, and the checks that read the moderated
+# data's periods for every line (the input's presence, the rows with signal) would misjudge them.
+AUTO_MIN_PERIODS = 4
 COVARIANCES = ("analytic", "bootstrap", "realisations", "none")
 
 
@@ -91,7 +96,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
              kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
              lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
              max_iter: int = 50, covariance: str = "analytic", bootstrap: int = 200,
-             seed=None, noise: str = "sample", disturbances: Optional[str] = None) -> IdentificationResult:
+             seed=None, noise: str = "auto", disturbances: Optional[str] = None) -> IdentificationResult:
     """Estimate an LPTV model from noisy input/output periods.
 
     Parameters
@@ -155,17 +160,22 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         The number of refits for ``covariance='bootstrap'`` (at least 20).
     seed : int, optional
         Seeds the bootstrap's draws.
-    noise : {'sample', 'moderated'}
-        The noise (co)variances the fit weighs by. 'sample' (default): each line's own, from
-        its P periods. 'moderated': each line's combined with its neighbours' by
+    noise : {'auto', 'sample', 'moderated'}
+        The noise (co)variances the fit weighs by. 'sample': each line's own, from its P
+        periods. 'moderated': each line's combined with its neighbours' by
         :func:`lptv.moderated_noise` (empirical Bayes, METHOD.md section 7), worth about
-        1 + nu / 2 periods (nu the lines' median degrees of freedom, often 40-60 at P = 4 when
+        1 + nu / 2 periods (nu the lines' median degrees of freedom, often 40-120 at P = 4 when
         the noise spectrum is smooth); the covariance's small-sample factor is taken at those
-        periods. At P = 4-8 it lowers the variance of SML's estimate by 10-30 % and calibrates
-        its analytic intervals (bench/HISTORY.md, "Fits weighed by moderated noise"); it
-        assumes a noise spectrum that is smooth over a few lines (lines far above their
-        neighbours keep their own variance). Not with ``covariance='bootstrap'``. ``res.data``
-        holds the moderated data the fit used.
+        periods. At P = 4-8 it lowers the variance of the estimate by 10-45 % and calibrates
+        the analytic intervals, which the sample variances make 1.5-2.6 times too wide at
+        P = 4 (bench/HISTORY.md, "The default noise route"); it assumes a noise spectrum that
+        is smooth over a few lines (lines far above their neighbours keep their own variance).
+        'auto' (default): 'moderated' when every experiment has P >= 4 periods and its noise
+        spectrum passes the smoothness check of :func:`lptv.moderation.smooth_noise` (prior
+        degrees of freedom d0 at least the lines' own 2 (P - 1), at most 10 % of the lines
+        outlying), 'sample' otherwise, and for ``covariance='bootstrap'`` or ``'realisations'`` and the
+        realisations of :meth:`lptv.DistortionResult.experiments`. ``res.noise`` says which
+        was used and ``res.noise_choice`` why. ``res.data`` holds the data the fit used.
     disturbances : {None, 'remove'}
         'remove': before the fit, find the sinusoids that are not periodic in the record (off
         the period's grid, such as mains hum beside a multisine whose period is not a multiple
@@ -214,8 +224,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if not isinstance(covariance, str) or covariance not in COVARIANCES:
         raise ValueError(f"covariance must be one of {COVARIANCES}, got {covariance!r}")
-    if not isinstance(noise, str) or noise not in ("sample", "moderated"):
-        raise ValueError(f"noise must be 'sample' or 'moderated', got {noise!r}")
+    if not isinstance(noise, str) or noise not in NOISES:
+        raise ValueError(f"noise must be one of {NOISES}, got {noise!r}")
     if noise == "moderated" and covariance == "bootstrap":
         raise ValueError("noise='moderated' is not for covariance='bootstrap': the bootstrap draws P periods "
                          "from each line's own sample variances; use covariance='analytic' with moderated noise")
@@ -239,8 +249,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         data = frequency_data_of(u, y, w0, ts)
     ts = data.ts if ts is None else ts
     moderation = ()
-    if noise == "moderated":
+    choice = "asked for"
+    if noise == "auto":
+        noise, choice, pairs = _auto_noise(datas if several else [data], covariance)
+    elif noise == "moderated":
         pairs = [_moderated(d) for d in (datas if several else [data])]
+    if noise == "moderated":
         moderation = tuple(m for _, m in pairs)
         if several:
             datas = [d for d, _ in pairs]
@@ -307,7 +321,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         warnings=tuple(r.warnings), data=None if several else data, eta_names=tuple(r.eta_names),
         covariance=None if cov is None else np.asarray(cov), nearly_unidentifiable=r.nearly_unidentifiable,
         experiment=np.asarray(r.experiment, dtype=int), experiments=tuple(datas) if several else (),
-        unstable=unstable, stability_undecided=undecided, structure=structure, noise=noise,
+        unstable=unstable, stability_undecided=undecided, structure=structure, noise=noise, noise_choice=choice,
         moderation=moderation, disturbances=found, covariance_dof=cov_dof, covariance_option=covariance)
 
 
@@ -341,7 +355,33 @@ def _without_disturbances(u, y, several):
     return items, None, tuple(found)
 
 
-def _moderated(d):
+def _auto_noise(datas, covariance):
+    """noise='auto': ('moderated' or 'sample', the sentence saying why, the moderated data and
+    their ModeratedNoise per experiment for 'moderated', else None)."""
+    from .moderation import moderated_noise, smooth_noise
+
+    if covariance in ("bootstrap", "realisations"):
+        return "sample", f"the sample variances: covariance='{covariance}' resamples them", None
+    if any(getattr(d, "distortion", None) is not None for d in datas):
+        return "sample", "the sample variances: the data are realisations of lptv.distortion", None
+    pairs, why = [], []
+    for d in datas:
+        if d.periods < 2:
+            return "sample", "the sample variances: the data do not come from periods", None
+        if d.periods < AUTO_MIN_PERIODS:
+            return "sample", (f"the sample variances: {d.periods} periods (the moderated route needs "
+                              f"{AUTO_MIN_PERIODS}: the lines that keep their own variance would have "
+                              f"{2 * (d.periods - 1)} degrees of freedom)"), None
+        mo = moderated_noise(d)
+        ok, reason = smooth_noise(mo)
+        why.append(reason)
+        if not ok:
+            return "sample", "the sample variances: " + reason, None
+        pairs.append(_moderated(d, mo))
+    return "moderated", "moderated: " + "; ".join(why), pairs
+
+
+def _moderated(d, mo=None):
     """(the data with moderated (co)variances, the ModeratedNoise) for noise='moderated'; the data
     unchanged and None when they cannot be moderated (statistics not from periods, too few
     lines). The periods the moderated variances are worth: 1 + nu / 2, nu the median of the
@@ -350,7 +390,8 @@ def _moderated(d):
 
     if d.periods < 2:
         return d, None
-    mo = moderated_noise(d)
+    if mo is None:
+        mo = moderated_noise(d)
     if mo.prior_dof <= 0:
         return d, None
     Pe = max(int(d.periods), int(round(1.0 + float(np.median(mo.dof[1:-1])) / 2.0)))

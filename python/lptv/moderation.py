@@ -168,3 +168,47 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
                           own_weight=np.array(core.own_weight, dtype=float),
                           neighbour=np.array(core.neighbour, dtype=bool), source_varU=vu, source_varY=vy,
                           source_covYU=data.covYU, _core=core)
+
+
+SMOOTH_MAX_OUTLIERS = 0.10
+"""The smoothness check (:func:`smooth_noise`) fails when more than this share of the lines keep
+their own variance (outlying above their neighbours)."""
+
+
+def smooth_noise(mo: ModeratedNoise):
+    """The smoothness check of ``identify(..., noise='auto')`` (METHOD.md section 7, "The
+    default noise route"): (passed, the sentence saying why).
+
+    The noise spectrum counts as smooth across lines when the prior degrees of freedom d0 that
+    :func:`moderated_noise` estimated from the spread of the log variances about their local
+    trend are at least the lines' own d = 2 (P - 1) (the neighbours then know a line's
+    variance at least as well as its own periods do), and at most ``SMOOTH_MAX_OUTLIERS`` of the
+    lines kept their own variance (a spectrum of many narrow peaks is not smooth).
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> from lptv.moderation import smooth_noise
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.standard_normal((4, 512)); y = rng.standard_normal((4, 512))
+    >>> ok, why = smooth_noise(lptv.moderated_noise(lptv.FrequencyData.from_periods(u, y, w0=1.0)))
+    >>> ok
+    True
+    """
+    if not isinstance(mo, ModeratedNoise):
+        raise ValueError(f"mo must be an lptv.ModeratedNoise, got {type(mo).__name__}")
+    P = int(mo.data.periods)
+    d = 2.0 * (P - 1)
+    d0 = float(mo.prior_dof)
+    inner = max(int(np.size(mo.dof)) - 2, 1)
+    share = np.size(mo.outliers) / inner
+    if d0 <= 0:
+        return False, "the noise variances cannot be moderated (too few lines with noise, or not from periods)"
+    if d0 < d:
+        return False, (f"the noise spectrum is not smooth across lines (prior degrees of freedom d0 = {d0:.3g} "
+                       f"< the lines' own {d:.3g})")
+    if share > SMOOTH_MAX_OUTLIERS:
+        return False, (f"the noise spectrum is not smooth across lines ({np.size(mo.outliers)} of {inner} lines "
+                       f"stand out above their neighbours)")
+    return True, (f"the noise spectrum is smooth across lines (prior degrees of freedom d0 = {d0:.3g} >= {d:.3g}; "
+                  f"{np.size(mo.outliers)} of {inner} lines outlying)")

@@ -93,6 +93,10 @@ class IdentificationResult:
     noise: str = "sample"
     """'sample' (each line's own sample (co)variances) or 'moderated' (moderated across
     neighbouring lines, :func:`lptv.moderated_noise`): the noise model the fit weighed by."""
+    noise_choice: str = "asked for"
+    """Why ``noise`` is what it is: 'asked for', or with ``noise='auto'`` the smoothness check's
+    sentence (e.g. "moderated: the noise spectrum is smooth across lines (prior degrees of
+    freedom d0 = 1e+06 >= 6; 0 of 255 lines outlying)")."""
     moderation: Tuple[object, ...] = field(default_factory=tuple, repr=False, compare=False)
     """noise='moderated': per experiment, the :class:`lptv.ModeratedNoise` the fit used (None for
     an experiment whose variances could not be moderated); empty otherwise."""
@@ -444,6 +448,8 @@ class IdentificationResult:
                       + (f", {m.outliers.size} lines kept their own)" if m.outliers.size else ")"))
                      for m, d in zip(self.moderation, self.experiments or (self.data,))]
             lines.append("noise: moderated across neighbouring lines, " + "; ".join(worth))
+        if self.noise_choice != "asked for":
+            lines.append("noise route (noise='auto'): " + self.noise_choice)
         if self.disturbances:
             lines.append("removed before the fit: " + "; ".join(
                 f"{d.signal}: a sinusoid at line {d.line:.3f} (amplitude {d.amplitude:.3g})" for d in self.disturbances))

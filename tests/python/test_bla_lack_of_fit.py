@@ -421,7 +421,7 @@ def test_the_realisations_with_their_noise_alone():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         plain = lptv.identify([(u[i], y[i]) for i in range(6)], w0=m.w0, ts=m.ts, lines=rows, method="sml",
-                              **DISCRETE_STRUCTURE)
+                              noise="sample", **DISCRETE_STRUCTURE)
         res = lptv.identify(exps, lines=rows, method="sml", covariance="realisations", **DISCRETE_STRUCTURE)
     np.testing.assert_array_equal(res.eta, plain.eta)
     # judged by the lack of fit alone (the cost and the prediction error hold the distortion:

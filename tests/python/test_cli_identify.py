@@ -431,8 +431,16 @@ def test_moderated_noise_option(tmp_path, capsys):
     model = lptv.Model.load(tmp_path / "o" / "model.json")
     np.testing.assert_allclose(model.covariance, ref.covariance, rtol=1e-9, atol=0)
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["noise"] == "moderated"
-    rc, out, err = identify_cli(capsys, src, src, *args, "--noise", "moderated")
-    assert rc == 2 and "--noise moderated takes one record" in err and err.count("\n") == 1
+    # a batch weighs every file's fit by its own moderated noise, and says so per row
+    src2 = tmp_path / "dt2.npz"
+    np.savez(src2, u=d["u"], y=d["y"])
+    rc, out, err = identify_cli(capsys, src, src2, *args, "--noise", "moderated", "--out", tmp_path / "b")
+    assert rc in (0, 3), err
+    import csv
+    with open(tmp_path / "b" / "results.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["noise"] for r in rows] == ["moderated", "moderated"]
+    assert float(rows[0]["a0.re0"]) == pytest.approx(ref.eta[0], rel=1e-9)
 
 
 def test_remove_disturbances_option(tmp_path, capsys):

@@ -90,7 +90,7 @@ def monte_carlo(P, runs, seed):
     ms = lptv.multisine(range(1, 25, 2), SMALL_N, seed=seed)
     y0 = lptv.time_signal(lptv.simulate(m, ms.spectrum), SMALL_N)
     rng = np.random.default_rng(seed)
-    errs = {"tls": [], "wgtls": []}
+    errs = {"tls": [], "wgtls": []}      # weighed by the sample variances: the claim is theirs
     truth = np.concatenate([m.a.ravel(), m.b.ravel()])
     for _ in range(runs):
         u, y = noisy_periods(ms.signal, y0, P, 20, 20, seed=rng, correlation=0.3)
@@ -98,7 +98,7 @@ def monte_carlo(P, runs, seed):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 r = lptv.identify(u, y, na=1, nb=0, ka=1, kb=1, w0=m.w0, lines=range(2, 26),
-                                  method=meth)
+                                  method=meth, noise="sample")
             errs[meth].append(np.concatenate([r.model.a.ravel(), r.model.b.ravel()]) - truth)
     return {k: np.array(v) for k, v in errs.items()}
 

@@ -80,6 +80,33 @@ def test_moderated_statistic_follows_F_with_the_stated_degrees_of_freedom():
     assert abs(u99 / n - 0.01) < 8 * se99, u99 / n
 
 
+@pytest.mark.parametrize("shape", ["slope", "roll-off"])
+def test_a_sloping_or_bending_noise_spectrum_is_moderated_without_bias(shape):
+    """The neighbours' arithmetic mean of a spectrum that slopes in log is biased up by the
+    exponential's convexity: at 0.43 dB a line (a second-order roll-off near 40 lines) the mean
+    over +-10 lines is 1 + 0.1^2 x 38.5 / 2 = 1.19 times the line's variance (and the roll-off
+(1 + l / 10)^-6 bends as well: 0.12 to 0.05 nepers a line over lines 40-120). The shape factor
+    of the local log-quadratic trend (METHOD.md section 7) removes it: over 40 data sets at
+    P = 4 the moderated variances of the lines away from the ends average within 3 % of the true
+    ones (sampling error of that mean about 0.5 %), where the plain mean is 10 % or more off."""
+    L = 300
+    l = np.arange(L + 1, dtype=float)
+    trend = np.exp(-0.1 * l) if shape == "slope" else (1.0 + l / 10.0) ** -6
+    inner = np.arange(40, L - 20) if shape == "slope" else np.arange(40, 120)
+    ratio, plain = [], []
+    for seed in range(40):
+        d = _data(np.full(L + 1, 1.0), trend, 4, 300 + seed)
+        mod = lptv.moderated_noise(d)
+        assert mod.prior_dof > 20
+        ratio.append(np.asarray(mod.data.varY)[inner] / (trend[inner] / 4))
+        n = 20
+        plain.append(np.array([(np.sum(d.varY[i - 10:i + 11]) - d.varY[i]) / n for i in inner])
+                     / (trend[inner] / 4))
+    bias = float(np.mean(ratio)) - 1
+    assert abs(bias) < 0.03, bias
+    assert float(np.mean(plain)) - 1 > 0.10         # what the shape factor corrects
+
+
 def test_rough_noise_keeps_each_line_near_its_own_variance():
     """Variances drawn independently per line over two decades: the neighbours know nothing,
     d0 comes out small and the line's own variance dominates: the spread's log-variance variance

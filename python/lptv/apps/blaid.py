@@ -53,7 +53,7 @@ def _fail(src, problem) -> int:
 
 def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     M, P, N = meas.u.shape
-    if getattr(args, "noise", "sample") != "sample":
+    if getattr(args, "noise", "auto") == "moderated":
         return _fail(src, "--noise moderated is for records of periods, not M x P x N realisations (their "
                           "variances are the noise's and the nonlinear distortion's, per realisation)")
     covariance = getattr(args, "covariance", "analytic")

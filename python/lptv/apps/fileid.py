@@ -144,10 +144,11 @@ def add_parser(sub):
                    "(intervals that include the nonlinear distortion's correlation across lines)")
     p.add_argument("--bootstrap", type=int, default=200, metavar="B",
                    help="refits for --covariance bootstrap (default 200)")
-    p.add_argument("--noise", default="sample", choices=("sample", "moderated"),
-                   help="the noise variances the fit weighs by: each line's own from its periods (default), "
+    p.add_argument("--noise", default="auto", choices=("auto", "sample", "moderated"),
+                   help="the noise variances the fit weighs by: each line's own from its periods (sample), "
                    "or moderated across neighbouring lines (smooth noise spectra; more precise estimates and "
-                   "calibrated intervals at few periods; one record or --joint)")
+                   "calibrated intervals at few periods); auto (default): moderated when the noise spectrum "
+                   "passes a smoothness check, the summary says which and why")
     p.add_argument("--referred", default="auto", choices=("auto", "output", "input", "none"),
                    help="a record of M x P x N realisations: the nonlinear distortion weighed as output noise "
                    "(output: a nonlinearity after the dynamics), referred to the input through a first fit "
@@ -240,11 +241,7 @@ def run(args) -> int:
         print(f"lptv identify: error: --covariance {args.covariance} takes one record at a time (not several "
               "files, --joint, --workers or --scheduler)", file=sys.stderr)
         return 2
-    if args.noise != "sample" and not args.joint and (len(args.files) > 1 or args.workers is not None
-                                                      or args.scheduler is not None):
-        print("lptv identify: error: --noise moderated takes one record or --joint (not a batch of files, "
-              "--workers or --scheduler)", file=sys.stderr)
-        return 2
+
     if args.remove_disturbances and (args.joint or len(args.files) > 1 or args.workers is not None
                                      or args.scheduler is not None):
         print("lptv identify: error: --remove-disturbances takes one record (not several files, --joint, "
@@ -388,7 +385,7 @@ def _summary(args, meas, w0, ka, kb, res, Y_pred, extra):
     return {
         "file": str(args.files[0]), "format": meas.format, "periods": P, "samples_per_period": N,
         "w0": w0, "ts": args.ts, "na": res.model.na, "nb": res.model.nb,
-        "ka": ka, "kb": kb, "method": res.method, "noise": res.noise,
+        "ka": ka, "kb": kb, "method": res.method, "noise": res.noise, "noise_choice": res.noise_choice,
         "disturbances_removed": [{"signal": d.signal, "line": d.line, "amplitude": d.amplitude, "phase": d.phase}
                                  for d in res.disturbances],
         "n_lines": int(res.lines.size), "first_line": int(res.lines.min()),

@@ -75,7 +75,7 @@ def run(args) -> int:
             warnings.simplefilter("ignore")  # identify's warnings are in res.warnings
             res = identify(datas, na=args.na, nb=args.nb, ka=ka, kb=kb, lines=per_file, method=args.method,
                            known=known, tol=args.tol, max_iter=args.max_iter,
-                           noise=getattr(args, "noise", "sample"))
+                           noise=getattr(args, "noise", "auto"))
     except (ValueError, NumericalError) as e:
         # name the files, not the list positions
         msg = re.sub(r"experiments?\[(\d+)\]|experiment (\d+)",

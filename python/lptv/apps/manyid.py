@@ -127,7 +127,7 @@ def run(args) -> int:
             raise FileError(f"--resume: {parts} holds no batch to resume")
         batch = dict(na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=args.ts, lines=lines, method=args.method,
                      known=known, tol=args.tol, max_iter=args.max_iter, periods=args.periods, read=_read(args),
-                     executor=executor, workers=workers, checkpoint=parts)
+                     executor=executor, workers=workers, checkpoint=parts, noise=getattr(args, "noise", "auto"))
     except (FileError, ValueError, ImportError, OSError) as e:
         return _error(e)
     seen = {}

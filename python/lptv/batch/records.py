@@ -13,14 +13,14 @@ from typing import Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_positive_float
-from ..identify import COVARIANCES, METHODS, _counts, _known_list, _rows, identify
+from ..identify import COVARIANCES, METHODS, NOISES, _counts, _known_list, _rows, identify
 from ..atomic import atomic_open, atomic_path
 from ..measurements import Measurements, read_measurements, read_options
 from ..model import Model
 from .executors import Failure, describe_executor, require, run_tasks
 
 # The columns every row has, before the parameters (eta and eta.std by name).
-COLUMNS = ("record", "ok", "error", "format", "periods", "samples", "w0", "method", "converged",
+COLUMNS = ("record", "ok", "error", "format", "periods", "samples", "w0", "method", "noise", "converged",
            "iterations", "cost", "fraction_above_0db", "fraction_expected", "residue_ok", "model_ok",
            "n_free_parameters", "warnings")
 
@@ -95,7 +95,7 @@ def identify_record(item, settings) -> dict:
     std = res.parameter_std
     return dict(
         record=name, ok=True, error="", format=fmt, periods=int(u.shape[0]), samples=int(n_samples),
-        w0=w0, method=res.method, converged=bool(res.converged), iterations=int(res.iterations),
+        w0=w0, method=res.method, noise=res.noise, converged=bool(res.converged), iterations=int(res.iterations),
         cost=float(res.cost), fraction_above_0db=float(res.fraction_above_0db),
         fraction_expected=float(res.fraction_expected), residue_ok=bool(res.residue_ok),
         model_ok=bool(res.model_ok),
@@ -209,7 +209,7 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
                   names: Optional[Sequence[str]] = None, covariance: str = "analytic",
                   executor="processes", workers: Optional[int] = None,
                   chunk_size: Optional[int] = None, progress: Optional[bool] = None,
-                  checkpoint=None, on_resume=None) -> BatchResult:
+                  checkpoint=None, on_resume=None, noise: str = "auto") -> BatchResult:
     """:func:`lptv.identify` on many records, one row of results per record.
 
     A record that cannot be read or fitted (a bad file, NaN in the data, a singular system)
@@ -239,6 +239,8 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
         As for :func:`lptv.identify`, for every record. 'none' leaves the ``.std`` columns empty
         and saves about 40 % of each WGTLS fit's time (the paper's example) when only the
         estimates are wanted.
+    noise : {'auto', 'sample', 'moderated'}
+        As for :func:`lptv.identify` (each record chooses its own route with 'auto').
     executor, workers, chunk_size, progress :
         Where and how the fits run (:func:`lptv.batch.run_tasks`).
     checkpoint : str or Path, optional
@@ -275,6 +277,10 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     if not isinstance(covariance, str) or covariance not in one_record:
         raise ValueError(f"covariance must be one of {one_record} (each record is fitted alone), "
                          f"got {covariance!r}")
+    if not isinstance(noise, str) or noise not in NOISES:
+        raise ValueError(f"noise must be one of {NOISES}, got {noise!r}")
+    if noise == "moderated" and covariance == "bootstrap":
+        raise ValueError("noise='moderated' is not for covariance='bootstrap'")
     na, nb = as_int(na, "na"), as_int(nb, "nb")
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     _known_list(known, ka_l, kb_l)
@@ -291,7 +297,7 @@ def identify_many(records, *, na: int, nb: int, ka=0, kb=0, w0: Optional[float] 
     names, recs = _names(records, names)
     settings = dict(w0=w0, ts=ts, periods=periods, read=read,
                     fit=dict(na=na, nb=nb, ka=ka_l, kb=kb_l, lines=lines, method=method, known=known,
-                             tol=float(tol), max_iter=max_iter))
+                             tol=float(tol), max_iter=max_iter, noise=noise))
     if covariance != "analytic":   # the settings of earlier checkpoints stay as they were
         settings["fit"]["covariance"] = covariance
     t0 = time.perf_counter()

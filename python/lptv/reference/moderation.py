@@ -108,6 +108,68 @@ def _window_sums(x: np.ndarray, keep: np.ndarray, W: int):
     return s, n
 
 
+SHAPE_WIDTH = 2
+"""The local log-quadratic trend that corrects the neighbours' mean for the spectrum's shape is
+fitted over +-SHAPE_WIDTH * half_width lines."""
+
+
+def _shape(z, ok, keep, W, var_log):
+    """Per position i: (k_i, v_i), the factor that turns the arithmetic mean of the neighbours'
+    variances (|j - i| <= W, j != i, keep[j]) into the trend's value at i, and the variance of
+    log k_i. The trend: z_j = alpha + beta x + c x^2 (x = j - i) fitted by least squares to the
+    log variances z over |x| <= SHAPE_WIDTH W (j != i, ok[j]); k_i = 1 / mean_j exp(beta x_j +
+    c x_j^2 - q_j / 2), q_j the fitted shape's variance at x_j (var_log times the normal
+    equations' inverse), which removes the fit's noise from the exponential's mean to first
+    order. Fewer than W points on either side of i within the fit's window (the first and last
+    lines: the trend at i would be extrapolated), or a singular fit: k = 1, v = 0."""
+    m = z.size
+    S = SHAPE_WIDTH * W
+    C = np.zeros((5, m))
+    T = np.zeros((3, m))
+    idx = np.arange(m)
+    for x in range(-S, S + 1):
+        if x == 0:
+            continue
+        j = idx + x
+        inside = (j >= 0) & (j < m)
+        jj = np.where(inside, j, 0)
+        use = inside & ok[jj]
+        zx = np.where(use, z[jj], 0.0)
+        for p in range(5):
+            C[p] += use * float(x) ** p
+        for p in range(3):
+            T[p] += zx * float(x) ** p
+    # points on each side of i within the window (a one-sided fit would extrapolate to i)
+    left = np.zeros(m, int)
+    right = np.zeros(m, int)
+    for x in range(1, S + 1):
+        left[x:] += ok[:m - x]
+        right[:m - x] += ok[x:]
+    k, v = np.ones(m), np.zeros(m)
+    for i in range(m):
+        if left[i] < W or right[i] < W:
+            continue
+        A = np.array([[C[0, i], C[1, i], C[2, i]], [C[1, i], C[2, i], C[3, i]], [C[2, i], C[3, i], C[4, i]]])
+        try:
+            Ai = np.linalg.inv(A)
+        except np.linalg.LinAlgError:
+            continue
+        if not np.all(np.isfinite(Ai)):
+            continue
+        theta = Ai @ T[:, i]
+        V = var_log * Ai[1:, 1:]
+        xs = np.array([x for x in range(-W, W + 1) if x != 0 and 0 <= i + x < m and keep[i + x]], float)
+        if xs.size == 0:
+            continue
+        X = np.stack([xs, xs ** 2], 1)
+        q = np.einsum("ja,ab,jb->j", X, V, X)
+        e = np.exp(X @ theta[1:] - q / 2)
+        k[i] = xs.size / e.sum()
+        a = (e[:, None] * X).sum(0) / e.sum()
+        v[i] = float(a @ V @ a)
+    return k, v
+
+
 def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     """:func:`lptv.moderated_noise` (its arguments, result and method, METHOD.md section 7) in
     NumPy and SciPy: the independent route the core's is tested against.
@@ -183,18 +245,33 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     use = keep & (n > 0)
     scale = max(d0 - 2.0, 0.0) / d0
     w = d / (d + d0)
+    # The neighbours' arithmetic mean, turned by each channel's shape factor into the trend's
+    # value at the line (a log spectrum that slopes or bends within the window biases the mean).
+    shape = []
+    for v in (vu, vy):
+        vi = v[inner]
+        okv = (vi > 0) & keep
+        if np.count_nonzero(okv) >= 3 * W:
+            z = np.log(np.where(okv, vi, 1.0)) - mean_log
+            shape.append(_shape(z, okv, keep, W, var_log))
+        else:
+            shape.append((np.ones(inner.size), np.zeros(inner.size)))
+    (ku, vku), (ky, vky) = shape
     mu, my, mc = vu.copy(), vy.copy(), c.copy()
-    for src, dst in ((vu, mu), (vy, my)):
+    for src, dst, kk in ((vu, mu, ku), (vy, my, ky)):
         s, _ = _window_sums(src[inner], keep, W)
-        dst[inner[use]] = w * src[inner[use]] + (1 - w) * scale * s[use] / n[use]
+        dst[inner[use]] = w * src[inner[use]] + (1 - w) * scale * kk[use] * s[use] / n[use]
     sr, _ = _window_sums(c[inner].real, keep, W)
     si, _ = _window_sums(c[inner].imag, keep, W)
-    mc[inner[use]] = w * c[inner[use]] + (1 - w) * scale * (sr[use] + 1j * si[use]) / n[use]
+    kc = np.sqrt(ku * ky)
+    mc[inner[use]] = w * c[inner[use]] + (1 - w) * scale * kc[use] * (sr[use] + 1j * si[use]) / n[use]
     bad = np.abs(mc) ** 2 > mu * my
     mc[bad] *= np.sqrt(mu[bad] * my[bad]) / np.abs(mc[bad])
-    # Satterthwaite: relative variance 2/d of the own part, 2/d0 + 2/(n d) of the prior's.
+    # Satterthwaite: relative variance 2/d of the own part, 2/d0 + 2/(n d) + v of the prior's
+    # (v the variance of the log shape factor).
     nn = n[use].astype(float)
-    dof[inner[use]] = (d + d0) ** 2 / (d + d0 + d0 ** 2 / (nn * d))
+    vk = np.maximum(vku, vky)[use]
+    dof[inner[use]] = (d + d0) ** 2 / (d + d0 + d0 ** 2 * (1.0 / (nn * d) + vk / 2.0))
     own_weight = np.ones(L + 1)
     own_weight[inner[use]] = w
     neighbour = np.zeros(L + 1, bool)
