@@ -53,6 +53,7 @@ SMOKE = {
     "bench_inspect.py": ["--runs", "12"],
     "bench_ml_lti.py": ["--rounds", "1", "--inner", "1", "--fditools", ""],
     "bench_moderation_core.py": ["1"],
+    "bench_noise_route.py": ["--runs", "2", "--periods", "4", "--workers", "1"],
     "bench_multi_experiment.py": ["3"],
     "bench_record.py": ["--runs", "3", "--periods", "4"],
     "bench_record_core.py": ["1", "4"],
@@ -69,6 +70,7 @@ SMOKE = {
     "bench_verdict_tests.py": ["--runs", "3", "--periods", "4", "--workers", "1"],
     "bench_wgtls.py": ["1", "1"],                        # seed 1, one round
     "ct_record_aliasing.py": ["--os", "4", "--seeds", "1"],
+    "periodic_records.py": [],                          # the records against their stated truth
 }
 
 # The slowest of SMOKE (Dask clusters started and stopped), started first.

@@ -192,7 +192,7 @@ def test_identify_with_moderated_noise_weighs_by_it_and_reports_its_periods(seed
     periods they are worth), agrees with the sample-weighted fit within their uncertainty, and
     its verdict reads the fit's own moderation (not a second one)."""
     d = _system(seed=seed)
-    ref = _fit(d, method="sml")
+    ref = _fit(d, method="sml", noise="sample")
     res = _fit(d, method="sml", noise="moderated")
     assert res.noise == "moderated" and ref.noise == "sample" and ref.moderation == ()
     mo = res.moderation[0]
@@ -264,4 +264,65 @@ def test_summary_says_the_noise_was_moderated():
     res = _fit(d, method="sml", noise="moderated")
     text = res.summary()
     assert f"noise: moderated across neighbouring lines, worth about {res.data.periods} periods per line" in text
-    assert "noise: moderated" not in _fit(d, method="sml").summary()
+    assert "noise: moderated" not in _fit(d, method="sml", noise="sample").summary()
+
+
+# ------------------------------------------------------------------ the default route, noise='auto'
+
+def _rough_periods(P, seed):
+    """The discrete-time example's noise-free periods plus noise whose variance is drawn per line
+    over two decades (independently: no neighbour knows a line's variance)."""
+    from lptv.examples import system_measurements
+    d = system_measurements("discrete", seed=seed, periods=P)
+    N = d["u0"].size
+    L = N // 2
+    rng = np.random.default_rng(seed)
+    v = 1e-6 * 10 ** rng.uniform(0, 2, (2, L + 1))
+    def noise(var):
+        X = (rng.standard_normal((P, L + 1)) + 1j * rng.standard_normal((P, L + 1))) * np.sqrt(var / 2) * N
+        X[:, 0], X[:, -1] = X[:, 0].real, X[:, -1].real
+        return np.array([np.fft.irfft(x, N) for x in X])
+    return dict(d, u=d["u0"] + noise(v[0]), y=d["y0"] + noise(v[1]))
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_the_default_route_moderates_smooth_noise_and_says_why(seed):
+    d = _system(seed=seed, P=4)          # white noise
+    res = _fit(d, method="sml")
+    assert res.noise == "moderated"
+    assert res.noise_choice.startswith("moderated: the noise spectrum is smooth across lines")
+    assert "noise route (noise='auto'): moderated" in res.summary()
+    asked = _fit(d, method="sml", noise="moderated")
+    np.testing.assert_array_equal(res.eta, asked.eta)
+    assert asked.noise_choice == "asked for"
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_the_default_route_keeps_the_sample_variances_of_rough_noise(seed):
+    d = _rough_periods(8, seed)
+    res = _fit(d, method="wgtls")
+    assert res.noise == "sample", res.noise_choice
+    assert "not smooth across lines" in res.noise_choice
+    np.testing.assert_array_equal(res.eta, _fit(d, method="wgtls", noise="sample").eta)
+
+
+def test_the_default_route_keeps_the_sample_variances_below_four_periods_and_for_the_bootstrap():
+    res = _fit(_system(seed=5, P=3), method="wgtls")
+    assert res.noise == "sample" and "3 periods" in res.noise_choice
+    res = _fit(_system(seed=5, P=4), method="wgtls", covariance="bootstrap", bootstrap=20)
+    assert res.noise == "sample" and "bootstrap" in res.noise_choice
+    with pytest.raises(ValueError, match="noise must be one of"):
+        _fit(_system(seed=5, P=4), noise="smooth")
+
+
+def test_the_smoothness_check_names_its_numbers():
+    from lptv.moderation import smooth_noise
+    L = 300
+    rng = np.random.default_rng(5)
+    v = 10 ** rng.uniform(-3, -1, (2, L + 1))
+    ok, why = smooth_noise(lptv.moderated_noise(_data(v[0], v[1], 8, 6)))
+    assert not ok and "d0 =" in why and "< the lines' own 14" in why
+    ok, why = smooth_noise(lptv.moderated_noise(_data(np.full(L + 1, 0.01), np.full(L + 1, 0.04), 4, 0)))
+    assert ok and ">= 6" in why
+    with pytest.raises(ValueError, match="mo must be an lptv.ModeratedNoise"):
+        smooth_noise("x")
