@@ -82,14 +82,16 @@ def main(argv=None):
     ap.add_argument("--kind", default="smooth", choices=("smooth", "rough", "white"),
                     help="the output noise's spectrum")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--first-seed", type=int, default=0, help="the realisations' seeds start here")
     args = ap.parse_args(argv)
     tasks = [(s, P, i, tuple(args.noise), args.kind) for s in args.systems for P in args.periods
-             for i in range(args.runs)]
+             for i in range(args.first_seed, args.first_seed + args.runs)]
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as ex:
         rows = [r for chunk in ex.map(one, tasks, chunksize=8) for r in chunk]
     R = args.runs
-    print(f"# {len(tasks)} records in {time.time() - t0:.0f} s; R = {R} per cell; output noise {args.kind}")
+    print(f"# {len(tasks)} records in {time.time() - t0:.0f} s; R = {R} per cell (seeds {args.first_seed}.."
+          f"{args.first_seed + R - 1}); output noise {args.kind}")
     print("| system | P | method | asked | taken | coverage (pooled) | worst parameter | reported / MC variance "
           "(median) | verdict's size |")
     print("|---|---|---|---|---|---|---|---|---|")
