@@ -10,7 +10,7 @@ DOCS = [README] + sorted((ROOT / "docs" / "guide").glob("*.md"))
 MARKERS = ("lptv.frozen_poles(res.model", "lptv.inspect(", "lptv.read_measurements(", "lptv.montecarlo(",
            "records.append(", "lptv.plots.distortion(d)", "lptv.min_crest_multisine(", "transient_record(",
            "continuous=True", 'referred="input"', 'referred="none"', 'disturbances="remove"',
-           "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", 'noise="moderated"')
+           "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", "res.noise_choice")
 
 
 def all_text():
@@ -261,9 +261,11 @@ def test_guide_mimo_example_runs(tmp_path, monkeypatch):
 
 
 def test_guide_identify_example_runs(tmp_path, monkeypatch):
-    """Four periods of the paper's example, weighed by moderated noise variances: consistent,
-    every parameter with its std; the fit without a covariance has none."""
-    ns = run_block('noise="moderated"', tmp_path, monkeypatch)
+    """Four periods of the paper's example, weighed by moderated noise variances (the default
+    route, which says so): consistent, every parameter with its std; the fit without a
+    covariance has none."""
+    ns = run_block("res.noise_choice", tmp_path, monkeypatch)
     res, quick = ns["res"], ns["quick"]
+    assert res.noise == "moderated" and res.noise_choice.startswith("moderated: the noise spectrum is smooth")
     assert res.converged and res.model_ok and (res.parameter_std[res.parameter_std > 0]).size == 34
     assert quick.converged and quick.covariance is None
