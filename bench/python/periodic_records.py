@@ -18,9 +18,9 @@ The noise is drawn per record: the input's white with a standard deviation of ``
 rms, the output's coloured (``"smooth"``: white noise through a second-order Butterworth low-pass
 at 0.2 of Nyquist, over a white floor 20 dB below its pass band: a spectrum with a knee, a slope
 and a floor; without the floor the periods' leakage dominates the lines 40 dB down, see
-METHOD.md section 7) or with a spectrum that is not smooth (``"rough"``: white noise through a
-filter with eight resonances (Q = 30: a few lines wide) over the band), at ``snr_out`` of the output's
-rms. Periods are cut from one long noise sequence (after a warm-up of its filter).
+METHOD.md section 7) or with a spectrum that is not smooth (``"rough"``: white noise through
+eight resonators from 0.05 to 0.4 of Nyquist, each about three lines wide, over a floor), at
+``snr_out`` of the output's rms. Periods are cut from one long noise sequence (after a warm-up of its filter).
 """
 from __future__ import annotations
 
@@ -98,7 +98,7 @@ def steady_state(system: str, seed: int = 0):
     raise ValueError(f"system must be one of {SYSTEMS}, got {system!r}")
 
 
-def _shaped(rng, n, kind):
+def _shaped(rng, n, kind, N):
     warm = 4000
     e = rng.standard_normal(n + warm)
     if kind == "white":
@@ -108,8 +108,8 @@ def _shaped(rng, n, kind):
         x = signal.lfilter(b, a, e) + 0.1 * rng.standard_normal(e.size)
     elif kind == "rough":
         x = np.zeros_like(e)
-        for fc in np.linspace(0.02, 0.4, 8):          # eight sharp resonances over the band
-            b, a = signal.iirpeak(fc, 30.0)
+        for fc in np.linspace(0.05, 0.4, 8):          # eight bumps about three lines wide over the band
+            b, a = signal.iirpeak(fc, max(fc * (N / 2) / 3.0, 0.7))
             x += signal.lfilter(b, a, e) * 3.0
         x += 0.3 * e
     else:
@@ -125,7 +125,7 @@ def record(system: str, periods: int, seed, *, noise: str = "smooth", snr_in: fl
     rng = np.random.default_rng(seed)
     N = u0.size
     nu = snr_in * np.std(u0) * rng.standard_normal(periods * N)
-    ny = snr_out * np.std(y0) * _shaped(rng, periods * N, noise)
+    ny = snr_out * np.std(y0) * _shaped(rng, periods * N, noise, N)
     u = np.tile(u0, periods) + nu
     y = np.tile(y0, periods) + ny
     st = STRUCTURES[system]

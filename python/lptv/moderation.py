@@ -175,6 +175,73 @@ SMOOTH_MAX_OUTLIERS = 0.10
 their own variance (outlying above their neighbours)."""
 
 
+SMOOTH_LAG_SIGMAS = 2.5
+"""The smoothness check fails when the correlation of neighbouring lines' log-variance residuals
+exceeds this many of its standard errors 1 / sqrt(n) (n pairs of lines)."""
+
+
+def _trend_residuals(v, keep, W):
+    """Per line of ``v`` (variances of lines 1..Lmax-1): log v minus the value at the line of the
+    least-squares quadratic in the offset x fitted to the other lines' log v over |x| <= 2 W
+    (lines not kept and non-positive left out); NaN where fewer than W lines lie on either side."""
+    m = v.size
+    ok = keep & (v > 0)
+    z = np.where(ok, np.log(np.where(ok, v, 1.0)), 0.0)
+    S = 2 * W
+    C = np.zeros((5, m))
+    T = np.zeros((3, m))
+    left = np.zeros(m)
+    right = np.zeros(m)
+    idx = np.arange(m)
+    for x in range(-S, S + 1):
+        if x == 0:
+            continue
+        j = idx + x
+        inside = (j >= 0) & (j < m)
+        use = inside & ok[np.where(inside, j, 0)]
+        zx = np.where(use, z[np.where(inside, j, 0)], 0.0)
+        for q in range(5):
+            C[q] += use * float(x) ** q
+        for q in range(3):
+            T[q] += zx * float(x) ** q
+        (left if x < 0 else right)[:] += use
+    good = ok & (left >= W) & (right >= W)
+    A = np.stack([np.stack([C[0], C[1], C[2]], -1), np.stack([C[1], C[2], C[3]], -1),
+                  np.stack([C[2], C[3], C[4]], -1)], -2)[good]
+    r = np.full(m, np.nan)
+    if good.any():
+        alpha = np.linalg.solve(A, T[:, good].T[..., None])[:, 0, 0]
+        r[good] = z[good] - alpha
+    return r
+
+
+def _lag_correlation(mo: ModeratedNoise):
+    """The largest over the input and output of the correlation of neighbouring lines' residuals
+    about the local log-quadratic trend, and its count of pairs (the smallest)."""
+    W = int(mo.half_width)
+    inner_n = int(np.size(mo.dof)) - 2
+    keep = np.ones(inner_n, bool)
+    if np.size(mo.outliers):
+        keep[np.asarray(mo.outliers, int) - 1] = False
+    worst, pairs = -1.0, 0
+    for v in (mo.source_varU, mo.source_varY):
+        if v is None:
+            continue
+        v = np.asarray(v, float)[1:-1]
+        if np.count_nonzero(v > 0) < 3 * W:
+            continue
+        r = _trend_residuals(v, keep, W)
+        a, b = r[:-1], r[1:]
+        ok = np.isfinite(a) & np.isfinite(b)
+        if ok.sum() < 3 * W:
+            continue
+        a, b = a[ok] - a[ok].mean(), b[ok] - b[ok].mean()
+        c = float(a @ b / np.sqrt((a @ a) * (b @ b))) if (a @ a) > 0 and (b @ b) > 0 else 0.0
+        if c > worst:
+            worst, pairs = c, int(ok.sum())
+    return worst, pairs
+
+
 def smooth_noise(mo: ModeratedNoise):
     """The smoothness check of ``identify(..., noise='auto')`` (METHOD.md section 7, "The
     default noise route"): (passed, the sentence saying why).
@@ -182,8 +249,13 @@ def smooth_noise(mo: ModeratedNoise):
     The noise spectrum counts as smooth across lines when the prior degrees of freedom d0 that
     :func:`moderated_noise` estimated from the spread of the log variances about their local
     trend are at least the lines' own d = 2 (P - 1) (the neighbours then know a line's
-    variance at least as well as its own periods do), and at most ``SMOOTH_MAX_OUTLIERS`` of the
-    lines kept their own variance (a spectrum of many narrow peaks is not smooth).
+    variance at least as well as its own periods do), at most ``SMOOTH_MAX_OUTLIERS`` of the
+    lines kept their own variance (a spectrum of many narrow peaks is not smooth), and the
+    residuals of neighbouring lines' log variances about their local quadratic trend (over
+    +-2 half_width lines, the line itself left out) do not correlate beyond
+    ``SMOOTH_LAG_SIGMAS`` standard errors, in the input or the output (a spectrum of bumps a few
+    lines wide, which the trend cannot follow and the moderation would smear, is not smooth;
+    for scatter about a smooth trend the residuals of neighbours are independent).
 
     Examples
     --------
@@ -210,5 +282,11 @@ def smooth_noise(mo: ModeratedNoise):
     if share > SMOOTH_MAX_OUTLIERS:
         return False, (f"the noise spectrum is not smooth across lines ({np.size(mo.outliers)} of {inner} lines "
                        f"stand out above their neighbours)")
+    corr, pairs = _lag_correlation(mo)
+    limit = SMOOTH_LAG_SIGMAS / np.sqrt(max(pairs, 1))
+    if pairs and corr > limit:
+        return False, (f"the noise spectrum is not smooth across lines (neighbouring lines' variances about "
+                       f"their trend correlate by {corr:.2f} > {limit:.2f}: bumps a few lines wide)")
     return True, (f"the noise spectrum is smooth across lines (prior degrees of freedom d0 = {d0:.3g} >= {d:.3g}; "
-                  f"{np.size(mo.outliers)} of {inner} lines outlying)")
+                  f"{np.size(mo.outliers)} of {inner} lines outlying; neighbouring lines' variances about "
+                  f"their trend correlate by {corr:.2f} <= {limit:.2f})")
