@@ -326,3 +326,19 @@ def test_the_smoothness_check_names_its_numbers():
     assert ok and ">= 6" in why
     with pytest.raises(ValueError, match="mo must be an lptv.ModeratedNoise"):
         smooth_noise("x")
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_smoothness_check_finds_bumps_a_few_lines_wide(seed):
+    """Noise whose variance has 20 bumps about three lines wide (a factor up to 5) on a flat floor:
+    scattered about no smooth trend, neighbouring lines' residuals correlate and the check fails
+    by that criterion; the same noise without the bumps passes."""
+    from lptv.moderation import smooth_noise
+    L = 300
+    l = np.arange(L + 1)
+    rng = np.random.default_rng(seed)
+    bumps = 1 + sum(4 * np.exp(-0.5 * ((l - c) / 1.5) ** 2) for c in rng.uniform(20, 280, 20))
+    ok, why = smooth_noise(lptv.moderated_noise(_data(np.full(L + 1, 0.01), 0.01 * bumps, 8, 40 + seed)))
+    assert not ok and "bumps a few lines wide" in why, why
+    ok, why = smooth_noise(lptv.moderated_noise(_data(np.full(L + 1, 0.01), np.full(L + 1, 0.01), 8, 40 + seed)))
+    assert ok and "correlate by" in why, why
