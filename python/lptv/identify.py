@@ -104,7 +104,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     (each column's entries with the same count in every row); ``kb`` likewise with (ny, nu).
     Methods 'gtls', 'wgtls' (vector residues weighted by their covariance matrices) and 'sml'
     (the exact likelihood of the rows); covariance 'analytic' (SML: the inverse Fisher
-    information; WGTLS: the first-order sandwich; both times (P-1)/(P-2-ny)) or 'none';
+    information; WGTLS: the first-order sandwich; both times (P-1)/(P-3)) or 'none';
     ``lines`` None (every usable line K+1..N/2-K), 'excited', a sequence, or one entry per
     experiment. 2-D arrays stay the single-input single-output fit below.
 

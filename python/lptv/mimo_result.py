@@ -50,7 +50,7 @@ class MimoIdentificationResult:
     n_free_parameters: int
     noise_free: bool
     covariance_factor: float
-    """The small-sample factor the covariance holds ((P-1)/(P-2-ny), 1 when left out)."""
+    """The small-sample factor the covariance holds ((P-1)/(P-3), 1 when left out)."""
     warnings: Tuple[str, ...] = ()
     tests: Tuple = field(default=(), repr=False)
     """(row index, output or -1 for the joint test, statistic, p-value) of each residue test."""
