@@ -92,13 +92,13 @@ def test_sml_and_covariances_match_reference(system, seed):
     cov_ref = np.linalg.inv(ref.fisher(st, res.eta, data))
     cov = res.covariance[np.ix_(free, free)] / res.covariance_factor
     assert np.allclose(cov, cov_ref, rtol=1e-8, atol=1e-10 * np.abs(cov_ref).max())
-    from lptv.mimo_fit import prepare, sandwich
+    from lptv.mimo_fit import core_data, core_structure, sandwich
     from lptv.mimo_data import MimoStructure
     datas = [MimoFrequencyData.from_periods(u, y, w0=mx.W0) for u, y in pairs]
     ny, nu = model.n_outputs, model.n_inputs
     s = STRUCTURE[system]
     mst = MimoStructure(s["na"], s["nb"], st.ka, st.kb, ny, nu, mx.W0)
-    sw = sandwich(prepare(datas, mst, [r for *_, r in data]), mst, res.eta)
+    sw = sandwich(core_data(datas, [r for *_, r in data]), core_structure(mst), res.eta)
     sw_ref = ref.sandwich(st, res.eta, data)
     assert np.allclose(sw, sw_ref, rtol=1e-8, atol=1e-10 * np.abs(sw_ref).max())
 
