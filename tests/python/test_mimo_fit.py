@@ -238,3 +238,13 @@ def test_docstring_examples_run():
     for mod in (lptv.mimo_data, lptv.mimo_examples, lptv.mimo_identify, lptv.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
+
+
+def test_crb_of_a_mimo_model_is_mimo_crb():
+    model = mx.SYSTEMS["2-in-1-out"]()[0]
+    d = lptv.mimo_multisines(LINES, N, 2, seed=1)
+    a = lptv.crb(model, d.spectra, var_y=1e-4, var_u=[1e-5, 2e-5], periods=8, ka=[1, 0, 0], kb=[1, 0])
+    b = lptv.mimo_crb(model, d.spectra, noise=[1e-4, 1e-5, 2e-5], periods=8, ka=[1, 0, 0], kb=[1, 0])
+    assert np.array_equal(a.covariance, b.covariance)
+    with pytest.raises(ValueError, match="^cov_yu"):
+        lptv.crb(model, d.spectra, var_y=1e-4, cov_yu=1e-6, periods=8)
