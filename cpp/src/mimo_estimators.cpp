@@ -34,6 +34,7 @@ struct Params {
   int ny = 1, nu = 1, na = 0, nphi = 0, nrow = 0, K = 0;
   std::vector<int> is_a, order, col, k, channel;
   MatrixXcd T;
+  std::vector<std::vector<std::pair<int, cd>>> tcols;  // T's nonzeros per column (one or two)
   std::vector<int> fixed_row;
   double w0 = 1.0, ts = 0.0;
   int nxi() const { return ny * nrow; }
@@ -88,6 +89,7 @@ Params make_params(const MimoStructure& st) {
   p.T = MatrixXcd::Zero(p.nphi, p.nrow);
   for (int j = 0; j < p.nrow; ++j)
     for (const auto& e : cols[j]) p.T(e.first, j) = e.second;
+  p.tcols = cols;
   return p;
 }
 
@@ -153,7 +155,16 @@ Prep prepare(const MimoSpectra& d, const Params& p) {
         const int i = d.rows[r] - p.k[a];
         x.Cphi[r](a, b) = std::conj(f[a]) * f[b] * d.C(i * c + p.channel[b], p.channel[a]);
       }
-    x.Cpsi[r] = p.T.adjoint() * x.Cphi[r] * p.T;
+    // T^H Cphi T through T's one or two nonzeros per column
+    MatrixXcd& Cp = x.Cpsi[r];
+    Cp.resize(p.nrow, p.nrow);
+    for (int i = 0; i < p.nrow; ++i)
+      for (int j = 0; j < p.nrow; ++j) {
+        cd v(0.0, 0.0);
+        for (const auto& a : p.tcols[i])
+          for (const auto& b : p.tcols[j]) v += std::conj(a.second) * x.Cphi[r](a.first, b.first) * b.second;
+        Cp(i, j) = v;
+      }
   }
   return x;
 }
@@ -195,9 +206,12 @@ void whitened(const Prep& x, const Params& p, const std::vector<MatrixXcd>* W, M
     }
     for (int q = 0; q < ny; ++q) {
       for (int pp = 0; pp < ny; ++pp) {
-        const VectorXcd v = M(q, pp) * x.Psi.row(r).transpose();
-        J.block(at, pp * nr, 1, nr) = v.real().transpose();
-        J.block(half + at, pp * nr, 1, nr) = v.imag().transpose();
+        const cd m = M(q, pp);
+        for (int i = 0; i < nr; ++i) {
+          const cd v = m * x.Psi(r, i);
+          J(at, pp * nr + i) = v.real();
+          J(half + at, pp * nr + i) = v.imag();
+        }
       }
       ++at;
     }
@@ -205,7 +219,7 @@ void whitened(const Prep& x, const Params& p, const std::vector<MatrixXcd>* W, M
       for (int qq = 0; qq < ny; ++qq) {
         const cd w = W ? (*W)[r](pp, qq) : cd(pp == qq ? 1.0 : 0.0, 0.0);
         if (w == cd(0, 0)) continue;
-        CJ.block(pp * nr, qq * nr, nr, nr) += (w * x.Cpsi[r]).real();
+        CJ.block(pp * nr, qq * nr, nr, nr) += w.real() * x.Cpsi[r].real() - w.imag() * x.Cpsi[r].imag();
       }
   }
 }
@@ -325,20 +339,33 @@ struct BandChol {
   }
 };
 
-// G[r][K + k] = [AA_{l,l-k}, -BB_{l,l-k}] (ny x (ny + nu)).
-std::vector<std::vector<MatrixXcd>> band_blocks(const Params& p, const MatrixXcd& Th, const std::vector<int>& rows) {
-  std::vector<std::vector<MatrixXcd>> G(rows.size(), std::vector<MatrixXcd>(2 * p.K + 1, MatrixXcd::Zero(p.ny, p.nc())));
+// G[r][K + k] = [AA_{l,l-k}, -BB_{l,l-k}] (ny x (ny + nu)), stored one above the other in one
+// matrix: block (r (2K+1) + K + k) of ny rows.
+struct BandBlocks {
+  MatrixXcd m;
+  int ny = 1, width = 1;
+  Eigen::Block<const MatrixXcd> operator()(int r, int kk) const {
+    return m.block((static_cast<Eigen::Index>(r) * width + kk) * ny, 0, ny, m.cols());
+  }
+};
+
+BandBlocks band_blocks(const Params& p, const MatrixXcd& Th, const std::vector<int>& rows) {
+  BandBlocks G;
+  G.ny = p.ny;
+  G.width = 2 * p.K + 1;
+  G.m = MatrixXcd::Zero(static_cast<Eigen::Index>(rows.size()) * G.width * p.ny, p.nc());
   for (size_t r = 0; r < rows.size(); ++r)
     for (int j = 0; j < p.nphi; ++j) {
       const cd f = (p.is_a[j] ? 1.0 : -1.0) * ipow(p.s(rows[r] - p.k[j]), p.order[j]);
-      G[r][p.K + p.k[j]].col(p.channel[j]) += f * Th.row(j).transpose();
+      const Eigen::Index top = (static_cast<Eigen::Index>(r) * G.width + p.K + p.k[j]) * p.ny;
+      for (int q = 0; q < p.ny; ++q) G.m(top + q, p.channel[j]) += f * Th(j, q);
     }
   return G;
 }
 
 // C_E of one experiment's rows (scalar index ny r + p): rows r and r + o share the lines
 // i = l - k = l' - k' when l' - l <= 2K; half bandwidth (2K + 1) ny - 1.
-HermitianBand row_covariance(const Prep& x, const Params& p, const std::vector<std::vector<MatrixXcd>>& G) {
+HermitianBand row_covariance(const Prep& x, const Params& p, const BandBlocks& G) {
   const MimoSpectra& d = *x.d;
   const int R = x.R(), ny = p.ny, K = p.K, c = p.nc();
   HermitianBand A;
@@ -353,7 +380,7 @@ HermitianBand row_covariance(const Prep& x, const Params& p, const std::vector<s
         const int k2 = kk + dl;
         if (k2 > 2 * K) continue;
         const int i = d.rows[r] - (kk - K);
-        blk.noalias() += G[r][kk] * d.C.block(static_cast<Eigen::Index>(i) * c, 0, c, c) * G[r + o][k2].adjoint();
+        blk.noalias() += G(r, kk) * d.C.block(static_cast<Eigen::Index>(i) * c, 0, c, c) * G(r + o, k2).adjoint();
       }
       for (int pp = 0; pp < ny; ++pp)
         for (int q = 0; q < ny; ++q) {
@@ -375,7 +402,7 @@ VectorXcd stacked(const MatrixXcd& E) {  // rows x ny -> index r ny + p
 }
 
 // d e / d xi at the denoised spectra z0_i = z_i - C_i sum_l G_{l,i}^H w_l, free columns only.
-MatrixXcd jacobian0(const Prep& x, const Params& p, const std::vector<std::vector<MatrixXcd>>& G,
+MatrixXcd jacobian0(const Prep& x, const Params& p, const BandBlocks& G,
                     const VectorXcd& w, const std::vector<int>& free) {
   const MimoSpectra& d = *x.d;
   const int R = x.R(), ny = p.ny, c = p.nc(), K = p.K;
@@ -383,7 +410,7 @@ MatrixXcd jacobian0(const Prep& x, const Params& p, const std::vector<std::vecto
   MatrixXcd corr = MatrixXcd::Zero(L1, c);
   for (int r = 0; r < R; ++r)
     for (int kk = 0; kk <= 2 * K; ++kk)
-      corr.row(d.rows[r] - (kk - K)) += (G[r][kk].adjoint() * w.segment(r * ny, ny)).transpose();
+      corr.row(d.rows[r] - (kk - K)) += (G(r, kk).adjoint() * w.segment(r * ny, ny)).transpose();
   MatrixXcd Y0 = d.Y, U0 = d.U;
   for (Eigen::Index i = 0; i < L1; ++i) {
     const VectorXcd dz = d.C.block(i * c, 0, c, c) * corr.row(i).transpose();

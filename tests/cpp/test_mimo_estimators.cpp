@@ -122,7 +122,7 @@ TEST_CASE("SML from WGTLS on noisy spectra", "[mimo_estimators]") {
   const lptv::MimoModel m = two_by_two();
   const Eigen::VectorXd xi = truth(m);
   const std::vector<int> free = lptv::mimo_free_indices(structure());
-  REQUIRE(free.size() == xi.size() - 4);
+  REQUIRE(static_cast<Eigen::Index>(free.size()) == xi.size() - 4);
   for (unsigned seed : {2u, 3u}) {
     const auto data = experiments(m, 0.02, seed);
     const lptv::MimoEstimate w = lptv::mimo_wgtls(data, structure(), 1e-10, 50);
