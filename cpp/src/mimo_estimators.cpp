@@ -471,8 +471,9 @@ Params checked_params(const MimoStructure& s, const VectorXd* xi) {
 
 }  // namespace
 
-std::vector<int> mimo_free_indices(const MimoStructure& s) {
-  const Params p = make_params(s);
+namespace {
+
+std::vector<int> free_of(const Params& p) {
   std::vector<bool> fixed(p.nxi(), false);
   for (int pp = 0; pp < p.ny; ++pp)
     for (int q = 0; q < p.ny; ++q) fixed[pp * p.nrow + p.fixed_row[q]] = true;
@@ -482,12 +483,10 @@ std::vector<int> mimo_free_indices(const MimoStructure& s) {
   return out;
 }
 
-MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructure& s, double tol, int max_iter,
+MimoEstimate wgtls_impl(const std::vector<Prep>& preps, const Params& p, bool noise_free, double tol, int max_iter,
                         bool weighted) {
-  const Params p = checked_params(s, nullptr);
-  const std::vector<Prep> preps = prepare_all(data, p);
   MimoEstimate out;
-  out.noise_free = all_zero(data);
+  out.noise_free = noise_free;
   Eigen::Index rows = 0;
   for (const Prep& x : preps) rows += 2 * x.R() * p.ny;
   const int d = p.ny * p.ny;
@@ -529,11 +528,8 @@ MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructur
   return out;
 }
 
-MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi0, double tol,
-                      int max_iter) {
-  const Params p = checked_params(s, &xi0);
-  const std::vector<Prep> preps = prepare_all(data, p);
-  const std::vector<int> free = mimo_free_indices(s);
+MimoEstimate sml_impl(const std::vector<Prep>& preps, const Params& p, const VectorXd& xi0, double tol, int max_iter) {
+  const std::vector<int> free = free_of(p);
   const double eps = std::numeric_limits<double>::epsilon();
   MimoEstimate out;
   out.xi = xi0;
@@ -587,15 +583,8 @@ MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure&
   return out;
 }
 
-MatrixXd mimo_fisher(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
-  const Params p = checked_params(s, &xi);
-  return evaluate(prepare_all(data, p), p, xi, mimo_free_indices(s), true).F;
-}
-
-MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
-  const Params p = checked_params(s, &xi);
-  const std::vector<Prep> preps = prepare_all(data, p);
-  const std::vector<int> free = mimo_free_indices(s);
+MatrixXd sandwich_impl(const std::vector<Prep>& preps, const Params& p, const VectorXd& xi) {
+  const std::vector<int> free = free_of(p);
   const MatrixXcd Th = theta_of(p, xi);
   const Eigen::Index nf = static_cast<Eigen::Index>(free.size());
   MatrixXd H = MatrixXd::Zero(nf, nf), Mt = MatrixXd::Zero(nf, nf);
@@ -616,16 +605,79 @@ MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure
   return Hi * Mt * Hi;
 }
 
-void mimo_residues(const MimoSpectra& d, const MimoStructure& s, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
-  const Params p = checked_params(s, &xi);
-  const std::vector<MimoSpectra> one{d};
-  check(one, p);
-  const Prep x = prepare(d, p);
+void residues_impl(const Prep& x, const Params& p, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
   const MatrixXcd Th = theta_of(p, xi);
   e = x.Phi * Th;
   const auto C = line_covariances(x, Th);
   Ce.resize(static_cast<Eigen::Index>(C.size()) * p.ny, p.ny);
   for (size_t r = 0; r < C.size(); ++r) Ce.middleRows(static_cast<Eigen::Index>(r) * p.ny, p.ny) = C[r];
+}
+
+}  // namespace
+
+std::vector<int> mimo_free_indices(const MimoStructure& s) { return free_of(make_params(s)); }
+
+MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructure& s, double tol, int max_iter,
+                        bool weighted) {
+  const Params p = checked_params(s, nullptr);
+  return wgtls_impl(prepare_all(data, p), p, all_zero(data), tol, max_iter, weighted);
+}
+
+MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi0, double tol,
+                      int max_iter) {
+  const Params p = checked_params(s, &xi0);
+  return sml_impl(prepare_all(data, p), p, xi0, tol, max_iter);
+}
+
+MatrixXd mimo_fisher(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
+  const Params p = checked_params(s, &xi);
+  return evaluate(prepare_all(data, p), p, xi, free_of(p), true).F;
+}
+
+MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
+  const Params p = checked_params(s, &xi);
+  return sandwich_impl(prepare_all(data, p), p, xi);
+}
+
+void mimo_residues(const MimoSpectra& d, const MimoStructure& s, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
+  const Params p = checked_params(s, &xi);
+  const std::vector<MimoSpectra> one{d};
+  check(one, p);
+  residues_impl(prepare(d, p), p, xi, e, Ce);
+}
+
+MimoFit mimo_fit(const std::vector<MimoSpectra>& data, const MimoStructure& s, const std::string& method, double tol,
+                 int max_iter, bool covariance) {
+  if (method != "gtls" && method != "wgtls" && method != "sml")
+    throw std::invalid_argument("method: must be 'gtls', 'wgtls' or 'sml', got '" + method + "'");
+  const Params p = checked_params(s, nullptr);
+  const std::vector<Prep> preps = prepare_all(data, p);
+  MimoFit out;
+  out.estimate = wgtls_impl(preps, p, all_zero(data), tol, max_iter, method != "gtls");
+  const bool noisy = !out.estimate.noise_free;
+  if (method == "sml" && noisy) out.estimate = sml_impl(preps, p, out.estimate.xi, tol, max_iter);
+  if (covariance && noisy) {
+    if (method == "sml") {
+      Eigen::LLT<MatrixXd> llt(out.estimate.information);
+      if (llt.info() != Eigen::Success) throw NumericalError("the Fisher information is not positive definite");
+      out.covariance = llt.solve(MatrixXd::Identity(out.estimate.information.rows(), out.estimate.information.cols()));
+    } else {
+      out.covariance = sandwich_impl(preps, p, out.estimate.xi);
+    }
+  }
+  Eigen::Index rows = 0;
+  for (const Prep& x : preps) rows += x.R();
+  out.residues.resize(rows, p.ny);
+  out.residue_covariance.resize(rows * p.ny, p.ny);
+  Eigen::Index at = 0;
+  for (const Prep& x : preps) {
+    MatrixXcd e, Ce;
+    residues_impl(x, p, out.estimate.xi, e, Ce);
+    out.residues.middleRows(at, x.R()) = e;
+    out.residue_covariance.middleRows(at * p.ny, x.R() * p.ny) = Ce;
+    at += x.R();
+  }
+  return out;
 }
 
 }  // namespace lptv

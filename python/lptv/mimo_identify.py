@@ -12,7 +12,7 @@ import numpy as np
 from ._validate import _array, as_float, as_int, as_lines, check_finite
 from .mimo import MimoModel
 from .mimo_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
-from .mimo_fit import FitError, core_data, core_structure, expand, fisher, residues, sandwich, sml, wgtls
+from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit
 from .mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
@@ -134,20 +134,15 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     data, cst = core_data(datas, rows_list), core_structure(st)
     warns = []
     try:
-        xi, iters, converged, sv, noise_free = wgtls(data, cst, tol=tol, max_iter=max_iter,
-                                                     method="gtls" if method == "gtls" else "wgtls")
-        d = ny * ny
-        if sv.size > d and sv[d] < 1.5 * sv[d - 1]:
-            warns.append(f"the model is nearly unidentifiable: the generalised singular value {d + 1} is "
-                         f"{sv[d] / sv[d - 1]:.3g} times value {d} (harmonic counts or orders too high, or a "
-                         "common periodic left factor)")
-        cost_sml = None
-        F = None
-        if method == "sml" and not noise_free:
-            xi, cost_sml, F, iters, converged = sml(data, cst, xi, tol=tol, max_iter=max_iter)
-        res, Ce = residues(data, cst, xi)
+        xi, iters, converged, sv, noise_free, cost_sml, free_cov, res, Ce = fit(
+            data, cst, method, tol=tol, max_iter=max_iter, covariance=covariance == "analytic")
     except FitError as err:
         raise ValueError(f"u, y: {err}") from None
+    d = ny * ny
+    if sv.size > d and sv[d] < 1.5 * sv[d - 1]:
+        warns.append(f"the model is nearly unidentifiable: the generalised singular value {d + 1} is "
+                     f"{sv[d] / sv[d - 1]:.3g} times value {d} (harmonic counts or orders too high, or a "
+                     "common periodic left factor)")
     n_scalar = res.size
     if cost_sml is not None:
         cost = cost_sml / n_scalar
@@ -157,7 +152,7 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         q = np.real(np.einsum("rp,rp->r", res.conj(), np.linalg.solve(Ce, res[..., None])[..., 0]))
         cost = float(np.sum(q)) / n_scalar
     cov, factor = None, 1.0
-    if covariance == "analytic" and not noise_free:
+    if free_cov is not None:
         Pmin = int(P.min())
         # (P-1)/(P-3) for every ny, calibrated by Monte Carlo (METHOD.md section 19): the
         # (P-1)/(P-2-ny) of the Wishart argument over-covers at ny = 2 (97.7 % at P = 8)
@@ -166,11 +161,6 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         else:
             warns.append(f"the covariance is without its small-sample factor (P - 1) / (P - 3): P = {Pmin} "
                          "periods, at least 4 needed")
-        try:
-            free_cov = np.linalg.inv(F if F is not None else fisher(data, cst, xi)) if method == "sml" \
-                else sandwich(data, cst, xi)
-        except (np.linalg.LinAlgError, FitError) as err:
-            raise ValueError(f"u, y: the covariance cannot be formed: {err}") from None
         cov = factor * expand(free_cov, st)
     for msg in warns:
         warnings.warn(msg, UserWarning, stacklevel=3)
