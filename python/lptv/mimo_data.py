@@ -54,7 +54,7 @@ class MimoFrequencyData:
                              f"got shape {y.shape}")
         P, N = u.shape[:2]
         if P < 2:
-            raise ValueError(f"u: {P} period: the noise (co)variances need P >= 2 periods (shape (P, N, nu))")
+            raise ValueError(f"u must hold P >= 2 periods for the noise (co)variances (shape (P, N, nu)), got {P}")
         z = np.concatenate([np.fft.rfft(y, axis=1), np.fft.rfft(u, axis=1)], axis=2) / N
         zm = z.mean(axis=0)
         dz = z - zm

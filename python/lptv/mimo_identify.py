@@ -246,7 +246,7 @@ def mimo_crb(model: MimoModel, inputs, *, noise, periods: int, lines=None, ka=No
         raise ValueError(f"noise must have shape ({c},), ({L1}, {c}) or ({L1}, {c}, {c}), got {Nz.shape}")
     check_finite(C, "noise")
     if np.any(np.real(np.diagonal(C, axis1=1, axis2=2)) < 0):
-        raise ValueError("noise: a variance is negative")
+        raise ValueError("noise must hold non-negative variances, got a negative one")
     from .fds import simulate
 
     ka = model.a.shape[3] // 2 if ka is None else ka
