@@ -248,3 +248,49 @@ def test_crb_of_a_mimo_model_is_mimo_crb():
     assert np.array_equal(a.covariance, b.covariance)
     with pytest.raises(ValueError, match="^cov_yu"):
         lptv.crb(model, d.spectra, var_y=1e-4, cov_yu=1e-6, periods=8)
+
+
+def discrete_model():
+    """A discrete-time 2 x 2 model (forward shift, N = 32 samples per period, ts = 1): A_2 = I,
+    A_1 constant, A_0 with a periodic entry, B_0 = [[1, 0.5], [0, 1]]."""
+    a = np.zeros((3, 2, 2, 3), complex)
+    a[2, :, :, 1] = np.eye(2)
+    a[1, :, :, 1] = [[-0.3, 0.05], [0.02, -0.2]]
+    a[0, :, :, 1] = [[0.1, 0.02], [0.0, 0.08]]
+    a[0, 0, 0, 0] = a[0, 0, 0, 2] = 0.03
+    a[0, 1, 0, 0], a[0, 1, 0, 2] = 0.02 - 0.01j, 0.02 + 0.01j
+    b = np.array([[[1.0, 0.5], [0.0, 1.0]]])
+    return lptv.MimoModel(a, b, w0=2 * np.pi / N, ts=1.0)
+
+
+@pytest.mark.parametrize("method", ["wgtls", "sml"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_discrete_time_matches_reference(method, seed):
+    model = discrete_model()
+    rng = np.random.default_rng(seed)
+    d = lptv.mimo_multisines(np.arange(2, 14), N, 2, seed=rng)
+    pairs = []
+    for e in range(2):
+        Y = np.asarray(lptv.simulate(model, d.spectra[e], lines_out=N // 2)).reshape(N // 2 + 1, -1)
+        y1 = np.fft.irfft(Y * N, N, axis=0)
+        u1 = d.signals[e]
+        pairs.append((u1[None] + 0.03 * u1.std(0) * rng.standard_normal((6, N, 2)),
+                      y1[None] + 0.03 * y1.std(0) * rng.standard_normal((6, N, 2))))
+    kw = dict(na=2, nb=0, ka=[1, 0, 0], kb=0)
+    res = lptv.identify(pairs, w0=model.w0, ts=1.0, method=method, tol=1e-12, max_iter=100, **kw)
+    assert res.model.discrete
+    st = ref.Structure(2, 0, counts([1, 0, 0], 2, 2), counts(0, 0, 2), model.w0, ts=1.0)
+    data = reference_data(pairs, st.K)     # the spectra and covariances do not depend on w0
+    xi_w, _ = ref.wgtls(st, data, tol=1e-12, max_iter=100)
+    if method == "wgtls":
+        assert np.abs(res.eta - xi_w).max() <= 1e-9 * np.abs(xi_w).max()
+    else:
+        xi_ref, _ = ref.sml(st, data, xi_w)
+        std = res.parameter_std / np.sqrt(res.covariance_factor)
+        assert np.abs(res.eta - xi_ref)[st.free].max() <= 1e-4 * std[st.free].min()
+    # the estimate is near the truth (a few standard deviations: the data are noisy)
+    a, b = model.a, model.b
+    from lptv.mimo_data import MimoStructure
+    truth = MimoStructure(2, 0, counts([1, 0, 0], 2, 2), counts(0, 0, 2), 2, 2, model.w0, 1.0).xi_of(a, b)
+    free = st.free
+    assert np.all(np.abs(res.eta - truth)[free] <= 6 * res.parameter_std[free])
