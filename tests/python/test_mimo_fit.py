@@ -294,3 +294,25 @@ def test_discrete_time_matches_reference(method, seed):
     truth = MimoStructure(2, 0, counts([1, 0, 0], 2, 2), counts(0, 0, 2), 2, 2, model.w0, 1.0).xi_of(a, b)
     free = st.free
     assert np.all(np.abs(res.eta - truth)[free] <= 6 * res.parameter_std[free])
+
+
+def test_excited_rows_and_frequency_data():
+    model, pairs = experiments("2-in-2-out", 6, P=8)
+    full = lptv.identify(pairs, w0=mx.W0, method="sml", **STRUCTURE["2-in-2-out"])
+    exc = lptv.identify(pairs, w0=mx.W0, method="sml", lines="excited", **STRUCTURE["2-in-2-out"])
+    # the excited lines and their +-K neighbours, K = 1, in each experiment
+    want = np.unique(np.concatenate([LINES + k for k in (-1, 0, 1)]))
+    want = want[(want >= 2) & (want <= N // 2 - 1)]
+    assert np.array_equal(np.unique(exc.lines), want) and exc.lines.size == 2 * want.size
+    # rows without signal carry little information: the two estimates agree within their uncertainty
+    free = full.parameter_std > 0
+    assert np.all(np.abs(exc.eta - full.eta)[free] <= 3 * exc.parameter_std[free])
+    # MimoFrequencyData as the data: the same fit
+    datas = [lptv.MimoFrequencyData.from_periods(u, y, w0=mx.W0) for u, y in pairs]
+    again = lptv.identify(datas, method="sml", **STRUCTURE["2-in-2-out"])
+    assert np.array_equal(again.eta, full.eta)
+    d = datas[0]
+    with pytest.raises(ValueError, match="^C must"):
+        lptv.MimoFrequencyData(U=d.U, Y=d.Y, C=d.C[:, :3], periods=8, w0=1.0)
+    with pytest.raises(ValueError, match="^Y must"):
+        lptv.MimoFrequencyData(U=d.U, Y=d.Y[:-1], C=d.C, periods=8, w0=1.0)
