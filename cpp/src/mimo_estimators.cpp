@@ -170,8 +170,27 @@ Prep prepare(const MimoSpectra& d, const Params& p) {
 }
 
 std::vector<MatrixXcd> line_covariances(const Prep& x, const MatrixXcd& Th) {
+  // C_{e,l} = Theta^T conj(Cphi_l) conj(Theta), explicit loops over the small blocks
+  const Eigen::Index n = Th.rows(), ny = Th.cols();
   std::vector<MatrixXcd> out(x.R());
-  for (int r = 0; r < x.R(); ++r) out[r] = Th.transpose() * x.Cphi[r].conjugate() * Th.conjugate();
+  MatrixXcd v(n, ny);
+  for (int r = 0; r < x.R(); ++r) {
+    const MatrixXcd& Cp = x.Cphi[r];
+    for (Eigen::Index q = 0; q < ny; ++q)
+      for (Eigen::Index a = 0; a < n; ++a) {
+        cd acc(0.0, 0.0);
+        for (Eigen::Index b = 0; b < n; ++b) acc += std::conj(Cp(a, b) * Th(b, q));
+        v(a, q) = acc;
+      }
+    MatrixXcd& C = out[r];
+    C.resize(ny, ny);
+    for (Eigen::Index pp = 0; pp < ny; ++pp)
+      for (Eigen::Index q = 0; q < ny; ++q) {
+        cd acc(0.0, 0.0);
+        for (Eigen::Index a = 0; a < n; ++a) acc += Th(a, pp) * v(a, q);
+        C(pp, q) = acc;
+      }
+  }
   return out;
 }
 
@@ -371,23 +390,44 @@ HermitianBand row_covariance(const Prep& x, const Params& p, const BandBlocks& G
   HermitianBand A;
   A.u = (2 * K + 1) * ny - 1;
   A.ab = MatrixXcd::Zero(A.u + 1, static_cast<Eigen::Index>(R) * ny);
-  MatrixXcd blk(ny, ny);
+  // H[r, kk] = G(r, kk) C_{l-k} once per row and line (ny x c), then each pair of rows sums
+  // H G'^H over the lines they share; explicit loops: the blocks are a few entries each
+  const int W = 2 * K + 1;
+  MatrixXcd H(static_cast<Eigen::Index>(R) * W * ny, c);
+  for (int r = 0; r < R; ++r)
+    for (int kk = 0; kk < W; ++kk) {
+      const int i = d.rows[r] - (kk - K);
+      const Eigen::Index top = (static_cast<Eigen::Index>(r) * W + kk) * ny;
+      for (int pp = 0; pp < ny; ++pp)
+        for (int b = 0; b < c; ++b) {
+          cd v(0.0, 0.0);
+          for (int a = 0; a < c; ++a) v += G.m(top + pp, a) * d.C(static_cast<Eigen::Index>(i) * c + a, b);
+          H(top + pp, b) = v;
+        }
+    }
+  std::vector<cd> blk(static_cast<size_t>(ny) * ny);
   for (int r = 0; r < R; ++r)
     for (int o = 0; o <= 2 * K && r + o < R; ++o) {
       const int dl = d.rows[r + o] - d.rows[r];
-      blk.setZero();
-      for (int kk = 0; kk <= 2 * K; ++kk) {
+      std::fill(blk.begin(), blk.end(), cd(0.0, 0.0));
+      for (int kk = 0; kk < W; ++kk) {
         const int k2 = kk + dl;
         if (k2 > 2 * K) continue;
-        const int i = d.rows[r] - (kk - K);
-        blk.noalias() += G(r, kk) * d.C.block(static_cast<Eigen::Index>(i) * c, 0, c, c) * G(r + o, k2).adjoint();
+        const Eigen::Index h = (static_cast<Eigen::Index>(r) * W + kk) * ny;
+        const Eigen::Index g = (static_cast<Eigen::Index>(r + o) * W + k2) * ny;
+        for (int pp = 0; pp < ny; ++pp)
+          for (int q = 0; q < ny; ++q) {
+            cd v(0.0, 0.0);
+            for (int b = 0; b < c; ++b) v += H(h + pp, b) * std::conj(G.m(g + q, b));
+            blk[pp * ny + q] += v;
+          }
       }
       for (int pp = 0; pp < ny; ++pp)
         for (int q = 0; q < ny; ++q) {
           if (o == 0) {
-            if (pp >= q) A.ab(pp - q, r * ny + q) = blk(pp, q);
+            if (pp >= q) A.ab(pp - q, r * ny + q) = blk[pp * ny + q];
           } else {
-            A.ab(o * ny + q - pp, r * ny + pp) = std::conj(blk(pp, q));  // entry ((r+o) ny + q, r ny + p)
+            A.ab(o * ny + q - pp, r * ny + pp) = std::conj(blk[pp * ny + q]);  // entry ((r+o) ny + q, r ny + p)
           }
         }
     }
@@ -410,7 +450,12 @@ MatrixXcd jacobian0(const Prep& x, const Params& p, const BandBlocks& G,
   MatrixXcd corr = MatrixXcd::Zero(L1, c);
   for (int r = 0; r < R; ++r)
     for (int kk = 0; kk <= 2 * K; ++kk)
-      corr.row(d.rows[r] - (kk - K)) += (G(r, kk).adjoint() * w.segment(r * ny, ny)).transpose();
+      for (int b = 0; b < c; ++b) {
+        cd v(0.0, 0.0);
+        const Eigen::Index top = (static_cast<Eigen::Index>(r) * (2 * K + 1) + kk) * ny;
+        for (int pp = 0; pp < ny; ++pp) v += std::conj(G.m(top + pp, b)) * w(r * ny + pp);
+        corr(d.rows[r] - (kk - K), b) += v;
+      }
   MatrixXcd Y0 = d.Y, U0 = d.U;
   for (Eigen::Index i = 0; i < L1; ++i) {
     const VectorXcd dz = d.C.block(i * c, 0, c, c) * corr.row(i).transpose();
