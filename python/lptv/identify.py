@@ -106,7 +106,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     (the exact likelihood of the rows); covariance 'analytic' (SML: the inverse Fisher
     information; WGTLS: the first-order sandwich; both times (P-1)/(P-3)) or 'none';
     ``lines`` None (every usable line K+1..N/2-K), 'excited', a sequence, or one entry per
-    experiment. 2-D arrays stay the single-input single-output fit below.
+    experiment; ``known={'a<na>': M}`` (M real, invertible, ny x ny) fixes the leading matrix's
+    mean to M instead of I (the estimate and its covariance are the A_na,0 = I ones multiplied by
+    M from the left). 2-D arrays stay the single-input single-output fit below.
 
     Parameters
     ----------

@@ -102,6 +102,24 @@ def _rows_of(d: MimoFrequencyData, lines, K: int, e: int):
     return rows
 
 
+def _known_leading(known, na, ny):
+    """known={'a<na>': M}: the mean of the leading matrix, ny x ny real and invertible (the only
+    known entries built for several channels), or None."""
+    if not known:
+        return None
+    if not isinstance(known, dict) or list(known) != [f"a{na}"]:
+        raise ValueError(f"known: for several inputs or outputs only the mean of the leading matrix is built, as "
+                         f"{{'a{na}': M}} with M real ny x ny; got {known!r}")
+    M = _array(known[f"a{na}"], "known")
+    if np.iscomplexobj(M) or M.shape != (ny, ny):
+        raise ValueError(f"known: a{na} must be a real {ny} x {ny} matrix (the mean of A_{na}), got shape {M.shape}")
+    M = M.astype(float)
+    check_finite(M, "known")
+    if np.linalg.cond(M) > 1e12:
+        raise ValueError(f"known: a{na} must be invertible (condition number {np.linalg.cond(M):.3g})")
+    return M
+
+
 def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None, method="wgtls",
                   known=None, tol=1e-10, max_iter=50, covariance="analytic") -> MimoIdentificationResult:
     """lptv.identify's route for several inputs or outputs (its docstring has the arguments)."""
@@ -109,15 +127,13 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         raise ValueError(f"method must be one of {MIMO_METHODS} for several inputs or outputs, got {method!r}")
     if not isinstance(covariance, str) or covariance not in ("analytic", "none"):
         raise ValueError(f"covariance must be 'analytic' or 'none' for several inputs or outputs, got {covariance!r}")
-    if known:
-        raise ValueError("known: known coefficients are not built yet for several inputs or outputs; the "
-                         "normalisation is A_na,0 = I (METHOD.md section 19)")
     na, nb = as_order(na, "na"), as_order(nb, "nb")
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=1)
     datas = _experiments(u, y, w0, ts)
     d0 = datas[0]
     ny, nu = d0.n_outputs, d0.n_inputs
+    lead = _known_leading(known, na, ny)
     ka_r = as_entry_counts(ka, na, ny, ny, "ka")
     kb_r = as_entry_counts(kb, nb, ny, nu, "kb")
     st = MimoStructure(na, nb, ka_r, kb_r, ny, nu, d0.w0, d0.ts)
@@ -164,6 +180,13 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         cov = factor * expand(free_cov, st)
     for msg in warns:
         warnings.warn(msg, UserWarning, stacklevel=3)
+    if lead is not None:
+        # the model with A_na,0 = M is M times the one with A_na,0 = I (the same system)
+        Kx = np.kron(lead, np.eye(st.n_row))
+        xi = Kx @ xi
+        cov = None if cov is None else Kx @ cov @ Kx.T
+        res = res @ lead.T
+        Ce = np.einsum("pi,rij,qj->rpq", lead, Ce, lead)
     a, b = st.coefficients(xi)
     model = MimoModel(a, b, w0=d0.w0, ts=d0.ts)
     row_P = np.concatenate([np.full(r.size, p) for r, p in zip(rows_list, P)])
