@@ -238,6 +238,10 @@ def test_docstring_examples_run():
     for mod in (lptv.mimo_data, lptv.mimo_examples, lptv.mimo_identify, lptv.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
+    # lptv.identify's own examples, the MIMO one included
+    test = doctest.DocTestFinder().find(lptv.identify, "identify", globs={})[0]
+    result = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE).run(test)
+    assert result.attempted > 0 and result.failed == 0
 
 
 def test_crb_of_a_mimo_model_is_mimo_crb():
