@@ -147,6 +147,10 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     if n_eq < st.free.size:
         raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters")
     P = np.array([d.periods for d in datas])
+    noisy = any(np.max(np.abs(d.C)) > 0 for d in datas)
+    if noisy and ny > 1 and P.min() <= ny:
+        raise ValueError(f"u, y: P = {int(P.min())} periods give residue covariances of rank at most P - 1 < ny = "
+                         f"{ny} (complex Wishart, METHOD.md section 19): several outputs need P > ny periods")
     data, cst = core_data(datas, rows_list), core_structure(st)
     warns = []
     try:

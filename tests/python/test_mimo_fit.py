@@ -220,6 +220,7 @@ def _pairs():
     (lambda p: lptv.identify(p[0][0], p[0][1] * np.nan, na=2, nb=0, w0=1.0), "y"),
     (lambda p: lptv.identify(p, na="x", nb=0, w0=1.0), "na"),
     (lambda p: lptv.mimo_crb("m", p[0][0], noise=1.0, periods=2), "model"),
+    (lambda p: lptv.identify([(u[:2], y[:2]) for u, y in p], na=2, nb=0, w0=1.0), "u, y: P = 2 periods"),
 ])
 def test_bad_inputs_name_the_argument(call, word):
     p = _pairs()
