@@ -285,9 +285,33 @@ void subspace(const MatrixXd& Jx, const MatrixXd* CJ, int d, MatrixXd& V, Vector
   MatrixXd Cs = sc.asDiagonal() * (*CJ) * sc.asDiagonal();
   Cs = 0.5 * (Cs + Cs.transpose()).eval();
   Eigen::LLT<MatrixXd> llt(Cs);
-  if (llt.info() != Eigen::Success)
-    throw NumericalError("the column covariance CJ_W is singular: some parameters' regressors carry no noise "
-                         "(an input measured without noise)");
+  if (llt.info() != Eigen::Success) {
+    // Some directions carry no noise (an input measured without noise): they have no
+    // denominator, so they are eliminated by least squares (the GSVD's infinite values) and the
+    // ratio is minimised over the noisy directions z, whitened by CJ_W's eigenvalues there.
+    Eigen::SelfAdjointEigenSolver<MatrixXd> es(Cs);
+    const VectorXd& lam = es.eigenvalues();
+    const double cut = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * lam.maxCoeff();
+    std::vector<Eigen::Index> i1, i2;
+    for (Eigen::Index j = 0; j < n; ++j) (lam(j) > cut ? i1 : i2).push_back(j);
+    if (static_cast<int>(i1.size()) < d)
+      throw NumericalError("the column covariance CJ_W has fewer noisy directions than the equivalent models");
+    MatrixXd B1(n, i1.size()), A2(R.rows(), i2.size());
+    for (size_t j = 0; j < i1.size(); ++j) B1.col(j) = es.eigenvectors().col(i1[j]) / std::sqrt(lam(i1[j]));
+    for (size_t j = 0; j < i2.size(); ++j) A2.col(j) = R * es.eigenvectors().col(i2[j]);
+    const MatrixXd A1 = R * B1;
+    Eigen::ColPivHouseholderQR<MatrixXd> qr2(A2);
+    const MatrixXd Qa = MatrixXd(qr2.householderQ()).leftCols(qr2.rank());
+    const MatrixXd P = A1 - Qa * (Qa.transpose() * A1);
+    Eigen::JacobiSVD<MatrixXd> svd(P, Eigen::ComputeFullV);
+    const MatrixXd Z = svd.matrixV().rightCols(d);
+    const MatrixXd Y2 = -qr2.solve(MatrixXd(A1 * Z));
+    MatrixXd X = B1 * Z;
+    for (size_t j = 0; j < i2.size(); ++j) X += es.eigenvectors().col(i2[j]) * Y2.row(j);
+    V = sc.asDiagonal() * X;
+    values = svd.singularValues().reverse();
+    return;
+  }
   const MatrixXd M = llt.matrixL().solve(R.transpose()).transpose();  // R Lc^-T
   Eigen::JacobiSVD<MatrixXd> svd(M, Eigen::ComputeFullV);
   V = sc.asDiagonal() * llt.matrixU().solve(MatrixXd(svd.matrixV().rightCols(d)));

@@ -73,8 +73,12 @@ class MimoFrequencyData:
         if P < 2:
             raise ValueError(f"u must hold P >= 2 periods for the noise (co)variances (shape (P, N, nu)), got {P}")
         z = np.concatenate([np.fft.rfft(y, axis=1), np.fft.rfft(u, axis=1)], axis=2) / N
-        zm = z.mean(axis=0)
-        dz = z - zm
+        # deviations from the first period, so that a channel whose periods are identical (an
+        # input measured without noise) has exactly zero (co)variances, not rounding
+        w = z - z[0]
+        wm = w.mean(axis=0)
+        zm = z[0] + wm
+        dz = w - wm
         C = np.einsum("plc,pld->lcd", dz, dz.conj()) / (P * (P - 1))
         ny = y.shape[2]
         return cls(U=zm[:, ny:].copy(), Y=zm[:, :ny].copy(), C=C, periods=P, w0=_w0(w0), ts=_ts(ts))

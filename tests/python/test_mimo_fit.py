@@ -19,7 +19,7 @@ STRUCTURE = {"2-in-2-out": dict(na=2, nb=0, ka=[1, 0, 0], kb=0), "1-in-2-out": d
              "2-in-1-out": dict(na=2, nb=1, ka=[1, 0, 0], kb=[1, 0])}
 
 
-def experiments(system, seed, P=6, level=0.03, n=N, lines=LINES):
+def experiments(system, seed, P=6, level=0.03, n=N, lines=LINES, input_level=None):
     """Orthogonal (Hadamard) experiments, E = nu, of a system's FDS steady state plus white noise
     of ``level`` times each channel's rms on every input and output sample."""
     model = mx.SYSTEMS[system]()[0]
@@ -31,7 +31,8 @@ def experiments(system, seed, P=6, level=0.03, n=N, lines=LINES):
         Y = np.asarray(lptv.simulate(model, U, lines_out=n // 2)).reshape(n // 2 + 1, -1)
         y1 = np.fft.irfft(Y * n, n, axis=0)
         u1 = d.signals[e]
-        u = u1[None] + level * u1.std(axis=0) * rng.standard_normal((P, n, u1.shape[1]))
+        lu = level if input_level is None else input_level
+        u = u1[None] + lu * u1.std(axis=0) * rng.standard_normal((P, n, u1.shape[1]))
         y = y1[None] + level * y1.std(axis=0) * rng.standard_normal((P, n, y1.shape[1]))
         out.append((u, y))
     return model, out
@@ -375,3 +376,22 @@ def test_prediction_of_a_fresh_experiment(system):
     err = np.abs(pred[lines] - y_true[lines])
     assert np.all(err <= 5 * sd[lines]), (err / sd[lines]).max()
     assert err.max() <= 0.02 * np.abs(y_true[lines]).max()
+
+
+@pytest.mark.parametrize("system", ["2-in-2-out", "2-in-1-out"])
+def test_inputs_without_noise(system):
+    """Inputs measured without noise: the b-columns of the Jacobian carry no noise and CJ_W is
+    singular; the core eliminates those directions, the reference reverses the pencil
+    (CJ v = mu H v). Both agree, for WGTLS and for SML from it."""
+    model, pairs = experiments(system, 9, input_level=0.0)
+    st = ref_structure(system)
+    data = reference_data(pairs, st.K)
+    assert np.all(data[0][2][:, -model.n_inputs:, :] == 0)        # the inputs' noise block is exactly zero
+    res = lptv.identify(pairs, w0=mx.W0, method="wgtls", tol=1e-12, max_iter=100, **STRUCTURE[system])
+    xi_ref, _ = ref.wgtls(st, data, tol=1e-12, max_iter=100)
+    assert res.converged
+    assert np.abs(res.eta - xi_ref).max() <= 1e-8 * np.abs(xi_ref).max()
+    sml = lptv.identify(pairs, w0=mx.W0, method="sml", tol=1e-12, **STRUCTURE[system])
+    xi_s, _ = ref.sml(st, data, xi_ref)
+    std = sml.parameter_std / np.sqrt(sml.covariance_factor)
+    assert np.abs(sml.eta - xi_s)[st.free].max() <= 1e-4 * std[st.free].min()
