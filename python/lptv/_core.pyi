@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoModel', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_htf', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_sandwich', 'mimo_sml', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -630,6 +630,59 @@ class MimoModel:
     @property
     def w0(self) -> float:
         ...
+class MimoStructure:
+    """
+    Row-uniform structure of a MIMO fit: ka (na+1) x ny, kb (nb+1) x nu.
+    """
+    def __init__(self, ny: typing.SupportsInt | typing.SupportsIndex, nu: typing.SupportsInt | typing.SupportsIndex, ka: typing.Annotated[numpy.typing.ArrayLike, numpy.int32, "[m, n]"], kb: typing.Annotated[numpy.typing.ArrayLike, numpy.int32, "[m, n]"], w0: typing.SupportsFloat | typing.SupportsIndex, ts: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
+        ...
+    @property
+    def nu(self) -> int:
+        ...
+    @property
+    def ny(self) -> int:
+        ...
+class MimoEstimate:
+    """
+    A MIMO WGTLS or SML estimate (see lptv.mimo_fit).
+    """
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def cost(self) -> float:
+        ...
+    @property
+    def information(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def noise_free(self) -> bool:
+        ...
+    @property
+    def singular_values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def xi(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+class MimoFit:
+    """
+    One MIMO fit: estimate, covariance (free entries), residues.
+    """
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def estimate(self) -> MimoEstimate:
+        ...
+    @property
+    def residue_covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
+    @property
+    def residues(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
 def band_matrix(model: Model, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
 def column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -752,8 +805,34 @@ def lp_norm_log(lines: collections.abc.Sequence[typing.SupportsInt | typing.Supp
     ...
 def mimo_band_matrix(model: MimoModel, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
+def mimo_fisher(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    Fisher information over the free entries
+    """
+def mimo_fit(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, method: str, tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex, covariance: bool = True) -> MimoFit:
+    """
+    WGTLS ('gtls', 'wgtls') or SML ('sml') from WGTLS with the covariance and the residues, the rows' terms formed once
+    """
+def mimo_free_indices(structure: MimoStructure) -> list[int]:
+    ...
 def mimo_htf(model: MimoModel, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
+def mimo_residues(data: tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple:
+    """
+    (residues rows x ny, their covariances (rows ny) x ny) of one experiment
+    """
+def mimo_sandwich(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    WGTLS's first-order sandwich covariance
+    """
+def mimo_sml(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex) -> MimoEstimate:
+    """
+    Levenberg-Marquardt on the rows' exact likelihood from xi0
+    """
+def mimo_wgtls(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex, weighted: bool = True) -> MimoEstimate:
+    """
+    WGTLS with vector residues and A_na,0 = I; data: list of (Y, U, C, rows), C of shape ((L+1)(ny+nu), ny+nu)
+    """
 def minimize_crest_factor(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex, oversample: typing.SupportsInt | typing.SupportsIndex = 0, max_p: typing.SupportsInt | typing.SupportsIndex = 1024, iterations_per_p: typing.SupportsInt | typing.SupportsIndex = 100) -> CrestResult:
     ...
 def moderated_noise(data: FrequencyData, half_width: typing.SupportsInt | typing.SupportsIndex) -> ModeratedNoise:
