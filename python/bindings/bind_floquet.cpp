@@ -21,6 +21,18 @@ void bind_floquet(py::module_& m) {
     return lptv::floquet(model, opt);
   }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
         "Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).");
+  m.def("floquet_mimo", [](const lptv::MimoModel& model, double tol, int min_truncation, int max_truncation) {
+    lptv::FloquetOptions opt;
+    opt.tol = tol;
+    opt.min_truncation = min_truncation;
+    opt.max_truncation = max_truncation;
+    py::gil_scoped_release release;  // the eigenvalue problems are C++ only
+    return lptv::floquet(model, opt);
+  }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
+        "Multipliers and exponents of the matrix system (see lptv.floquet for the documented API).");
+  m.def("mimo_row_degrees", &lptv::row_degrees, "model"_a, "The row degrees d_p of A(t, s).");
+  m.def("mimo_state_matrix", &lptv::state_matrix_at, "model"_a, "t"_a,
+        "The state (one-step) matrix of the matrix system's observer form at time t.");
   py::class_<lptv::ProductRadius>(m, "ProductRadius",
                                   "The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).")
       .def_readonly("settled", &lptv::ProductRadius::settled)

@@ -8,6 +8,7 @@ import numpy as np
 
 from . import _core
 from ._validate import as_int, as_positive_float
+from .mimo import MimoModel
 from .model import Model
 
 __all__ = ["FloquetResult", "UnstableModelWarning", "floquet", "monodromy", "stability_check",
@@ -56,13 +57,16 @@ class FloquetResult:
     """T0 = 2 pi / w0 in seconds."""
 
 
-def _check_model(model):
+def _check_model(model, mimo=False):
+    if mimo and isinstance(model, MimoModel):
+        return model
     if not isinstance(model, Model):
-        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+        kinds = "an lptv.Model or lptv.MimoModel" if mimo else "an lptv.Model"
+        raise ValueError(f"model must be {kinds}, got {type(model).__name__}")
     return model
 
 
-def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
+def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
             max_truncation: int = 256) -> FloquetResult:
     """Characteristic multipliers and Floquet exponents of ``model``: is it stable?
 
@@ -92,11 +96,19 @@ def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
     stabilised experiment, or simulation), it identifies an unstable system as it does a stable
     one, and does not say so. Check ``lptv.floquet(res.model).is_stable``.
 
+    Several outputs (an :class:`lptv.MimoModel`, METHOD.md section 19): the homogeneous
+    equation ``sum_n A_n(t) d^n y/dt^n = 0`` with A(t, s) row-reduced (row degrees d_p, the
+    highest order in row p; the matrix L(t) of row p's coefficients of order d_p invertible over
+    the period; equal degrees: A_na(t) invertible, as the mass matrix of M y'' + C y' + K(t) y).
+    Its state (the observer form, of dimension sum_p d_p) has sum_p d_p multipliers, computed as
+    above: Hill's method in continuous time, the product of the N one-step matrices in discrete
+    time. A 1 x 1 model gives the multipliers of the SISO model.
+
     Parameters
     ----------
-    model : lptv.Model
-        a_na(t) must not vanish over the period (continuous time: checked on a fine grid;
-        discrete time: at the N samples).
+    model : lptv.Model or lptv.MimoModel
+        a_na(t) (several outputs: L(t)) must not vanish (be singular) over the period
+        (continuous time: checked on a fine grid; discrete time: at the N samples).
     tol : float
         Continuous time: convergence tolerance of the truncation on ln(mu_i).
     min_truncation, max_truncation : int
@@ -132,13 +144,27 @@ def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
     (False, array([-1.0158, -0.8682]))
     >>> lptv.floquet(mathieu_model(zeta=0.02, wn=1.0, eps=0.06, w0=2.0)).is_stable
     True
+
+    Two masses coupled by a spring k_c(t) = 1 + 0.9 cos(w0 t) (k_1 = k_2 = 1, M = I): the
+    modes are at 1 and sqrt(3) rad/s, and the spring pumps the second one; at w0 = 2 sqrt(3)
+    (its parametric resonance) the system is unstable though every frozen pole is damped.
+
+    >>> kc = np.array([0.45, 1.0, 0.45])                     # harmonics -1, 0, 1 of k_c(t)
+    >>> S = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    >>> K = S[:, :, None] * kc
+    >>> K[:, :, 1] += np.eye(2)                              # k_1 = k_2 = 1
+    >>> two = lptv.MimoModel.mechanical(np.eye(2), 0.01 * np.eye(2), K, np.eye(2), w0=2 * 3 ** 0.5)
+    >>> f = lptv.floquet(two)
+    >>> f.multipliers.size, f.is_stable
+    (4, False)
     """
-    _check_model(model)
+    _check_model(model, mimo=True)
     tol = as_positive_float(tol, "tol")
     min_truncation = as_int(min_truncation, "min_truncation", minimum=1)
     max_truncation = as_int(max_truncation, "max_truncation", minimum=1)
-    r = _core.floquet(model._cpp, tol=tol, min_truncation=min_truncation,
-                      max_truncation=max_truncation)
+    route = _core.floquet_mimo if isinstance(model, MimoModel) else _core.floquet
+    r = route(model._cpp, tol=tol, min_truncation=min_truncation,
+              max_truncation=max_truncation)
     return FloquetResult(
         multipliers=np.asarray(r.multipliers), exponents=np.asarray(r.exponents),
         is_stable=bool(r.is_stable), spectral_radius=float(r.spectral_radius),
