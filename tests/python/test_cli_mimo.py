@@ -1,0 +1,156 @@
+"""``lptv identify FILES... --input f1,f2 --output x1,x2``: several inputs and outputs from files.
+
+The records are made outside lptv: SciPy's solve_ivp (DOP853) of the two-mass system of
+test_mimo_timedomain.py (M y'' + C y' + K(t) y = u, coupling spring k_c(t) = 2 (1 + 0.3 cos t)),
+at its periodic steady state (shooting), under multisines made with NumPy, one experiment per
+file with its own random phases, P noisy periods written as CSV columns. The command must give
+the model lptv.identify gives on the same arrays, exit 0 for the right structure and 3 when a
+harmonic of K(t) is missing; the options it cannot use and the channels it cannot find are
+one-line errors with exit status 2.
+"""
+import json
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import lptv
+from lptv.apps import cli, mimoid
+
+W0, N, P = 1.0, 64, 8
+T0 = 2 * np.pi / W0
+LINES = np.arange(1, 24, 2)            # odd lines: the +-1 sidebands of K(t) fall on even ones
+NOISE = 1e-4
+Mm, Cm, K0 = np.diag([1.0, 2.0]), np.diag([1.0, 2.0]), np.diag([5.0, 3.0])
+S = np.array([[1.0, -1.0], [-1.0, 1.0]])
+KC0, DEPTH = 2.0, 0.3
+
+
+def true_model():
+    Kh = np.zeros((2, 2, 3))
+    Kh[:, :, 1] = K0 + KC0 * S
+    Kh[:, :, 0] = Kh[:, :, 2] = KC0 * DEPTH / 2 * S
+    return lptv.MimoModel.mechanical(Mm, Cm, Kh, np.eye(2), w0=W0)
+
+
+def steady_period(seed):
+    """One period (N samples) of u (2 channels) and y (2 channels) at periodic steady state."""
+    rng = np.random.default_rng(seed)
+    phi = rng.uniform(0, 2 * np.pi, (2, LINES.size))
+    Minv = np.linalg.inv(Mm)
+
+    def u(t):
+        return np.sum(np.cos(np.multiply.outer(LINES * W0, np.atleast_1d(t))[None] + phi[:, :, None]), axis=1)
+
+    def f(t, x, forced=True):
+        y, v = x[:2], x[2:]
+        K = K0 + KC0 * (1 + DEPTH * np.cos(W0 * t)) * S
+        acc = -Minv @ (Cm @ v + K @ y) + (Minv @ u(t)[:, 0] if forced else 0)
+        return np.concatenate([v, acc])
+
+    def augmented(t, z):
+        Phi = z[4:].reshape(4, 4)
+        return np.concatenate([f(t, z[:4]), np.column_stack([f(t, Phi[:, j], False) for j in range(4)]).ravel()])
+
+    sol = solve_ivp(augmented, (0, T0), np.concatenate([np.zeros(4), np.eye(4).ravel()]), method="DOP853",
+                    rtol=1e-11, atol=1e-13)
+    Phi = sol.y[4:, -1].reshape(4, 4)
+    x0 = np.linalg.solve(np.eye(4) - Phi, sol.y[:4, -1])
+    t = np.arange(N) * T0 / N
+    sol = solve_ivp(f, (0, T0), x0, method="DOP853", rtol=1e-11, atol=1e-13, t_eval=t)
+    return u(t).T, sol.y[:2].T
+
+
+@pytest.fixture(scope="module")
+def experiments():
+    """Two experiments (u, y) of shape (P, N, 2), noisy periods of the steady state."""
+    out = []
+    for e in range(2):
+        u1, y1 = steady_period(10 + e)
+        rng = np.random.default_rng(20 + e)
+        u = np.tile(u1, (P, 1, 1)) + NOISE * rng.standard_normal((P, N, 2))
+        y = np.tile(y1, (P, 1, 1)) + NOISE * rng.standard_normal((P, N, 2))
+        out.append((u, y))
+    return out
+
+
+def write_csv(path, u, y, header="time,F1 [N],f2 [N],x1 [m],x2 [m]"):
+    t = np.arange(P * N) * T0 / N
+    np.savetxt(path, np.column_stack([t, u.reshape(-1, 2), y.reshape(-1, 2)]), fmt="%.17g", delimiter=",",
+               header=header, comments="")
+    return path
+
+
+@pytest.fixture()
+def files(experiments, tmp_path):
+    return [write_csv(tmp_path / f"exp{e}.csv", *experiments[e]) for e in range(2)]
+
+
+def identify_cli(capsys, *argv):
+    rc = cli.main(["identify", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+FIT = ["--input", "f1,f2", "--output", "x1,x2", "--period", T0, "--na", "2", "--nb", "0", "--ka", "1"]
+
+needs_fit = pytest.mark.skipif(not mimoid.mimo_fit_available(), reason="lptv.identify takes one channel only")
+
+
+@needs_fit
+def test_the_command_gives_the_python_api_model_and_accepts_the_right_structure(experiments, files, tmp_path,
+                                                                                 capsys):
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
+    assert rc == 0, out + err
+    assert "2 experiments, 2 inputs (F1 [N], f2 [N]), 2 outputs (x1 [m], x2 [m])" in out.splitlines()[0]
+    assert "verdict: consistent" in out
+    res = lptv.identify(experiments, na=2, nb=0, ka=1, kb=0, w0=W0, method="wgtls")
+    model = lptv.MimoModel.load(tmp_path / "o" / "model.json")
+    np.testing.assert_allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
+    np.testing.assert_allclose(model.b, res.model.b, rtol=0, atol=1e-10 * np.abs(res.model.b).max())
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["inputs"] == ["F1 [N]", "f2 [N]"] and summary["model_ok"] is True
+    names = [p["name"] for p in summary["parameters"]]
+    assert names == list(res.parameter_names)
+    std = np.array([np.nan if p["std"] is None else p["std"] for p in summary["parameters"]])
+    np.testing.assert_allclose(std, res.parameter_std, rtol=1e-8)
+    # the estimate against the system simulated: A_na,0 = I normalises M^-1 (M y'' + ...), so
+    # compare M^-1 K(t)'s harmonics within 5 standard deviations
+    true = np.einsum("pr,nrqk->npqk", np.linalg.inv(Mm), true_model().a)
+    for i, name in enumerate(res.parameter_names):
+        if name.startswith("a0[") and std[i] > 0:
+            p, q = (int(c) for c in name[3:name.index("]")].split(","))
+            k = int(name[-1])
+            value = true[0, p, q, 1 + k]
+            value = value.real if ".re" in name else value.imag
+            assert abs(res.eta[i] - value) <= 5 * std[i], (name, res.eta[i], value, std[i])
+
+
+@needs_fit
+def test_a_missing_harmonic_is_a_model_error(files, tmp_path, capsys):
+    fit = [x if x != "1" else "0" for x in FIT]               # --ka 0: K(t) taken as constant
+    rc, out, err = identify_cli(capsys, *files, *fit, "--out", tmp_path / "o")
+    assert rc == 3, out + err
+    assert "verdict: model error" in out
+
+
+def test_without_the_mimo_fit_the_command_says_so(files, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(mimoid, "mimo_fit_available", lambda: False)
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
+    assert rc == 2 and err.strip() == f"lptv identify: error: {mimoid.NEEDS_FIT}"
+    assert not (tmp_path / "o" / "model.json").exists()
+
+
+def test_channels_and_options_it_cannot_use_are_one_line_errors(files, tmp_path, capsys):
+    rc, out, err = identify_cli(capsys, *files, "--input", "f1,f3", *FIT[2:])
+    assert rc == 2 and "column 'f3', the input named by --input (u=), is missing" in err
+    assert err.startswith(f"lptv identify: error: {files[0]}: ") and len(err.strip().splitlines()) == 1
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--known", "a2=1")
+    assert rc == 2 and "--known is for one input and one output" in err
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--covariance", "bootstrap")
+    assert rc == 2 and "--covariance bootstrap is for one input and one output" in err
+    rc, out, err = identify_cli(capsys, *files, "--input", "f1,,f2", *FIT[2:])
+    assert rc == 2 and "an empty channel name" in err
+    rc, out, err = identify_cli(capsys, files[0], "--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb",
+                                "0", "--period", T0, "--fs", 3.3)
+    assert rc == 2 and "not a whole number" in err
