@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
 #include "floquet_detail.hpp"
@@ -228,6 +229,48 @@ Floquet floquet(const MimoModel& m, const FloquetOptions& opt) {
   check_row_reduced_ct(m, s);
   if (s.n == 0) return detail::hill_floquet({}, m.w0(), opt);
   return detail::hill_floquet(state_harmonics(m, s), m.w0(), opt);
+}
+
+Eigen::MatrixXd monodromy(const MimoModel& m, int steps) {
+  const Layout s = layout_of(m);
+  if (m.discrete()) {
+    const std::vector<Eigen::MatrixXd> G = step_matrices(m, s);
+    return s.n == 0 ? Eigen::MatrixXd(0, 0) : detail::product_of_steps(G).Phi;
+  }
+  if (steps < 1 || steps > (1 << 24)) {
+    throw std::invalid_argument("steps must be between 1 and 2^24, got " + std::to_string(steps));
+  }
+  check_row_reduced_ct(m, s);
+  if (s.n == 0) return Eigen::MatrixXd(0, 0);
+  const Eigen::MatrixXcd right = right_form(m, s);
+  // The fourth-order Magnus step of monodromy.cpp (F at the two Gauss points of each of S
+  // sub-intervals, Omega = h/2 (F1 + F2) + sqrt(3) h^2/12 [F2, F1]), and one Richardson step
+  // from S and 2 S: (16 Phi_{h/2} - Phi_h) / 15.
+  auto product = [&](int S) {
+    const double T0 = 2.0 * M_PI / m.w0(), h = T0 / S, g = std::sqrt(3.0) / 6.0;
+    Eigen::VectorXd t(2 * S);
+    for (int k = 0; k < S; ++k) {
+      t[2 * k] = (k + 0.5 - g) * h;
+      t[2 * k + 1] = (k + 0.5 + g) * h;
+    }
+    const Eigen::MatrixXd vals = evaluate_fourier(right, m.w0(), t);
+    auto F = [&](int i) {
+      const Eigen::MatrixXd L = leading_rows(s, vals, std::vector<int>(s.ny, i));
+      return state_matrix(s, L, [&](int nn, int p, int q) { return vals(i, arow(s.ny, nn, p, q)); });
+    };
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(s.n, s.n);
+    const double c1 = 0.5 * h, c2 = (std::sqrt(3.0) / 12.0) * h * h;
+    for (int k = 0; k < S; ++k) {
+      const Eigen::MatrixXd F1 = F(2 * k), F2 = F(2 * k + 1);
+      const Eigen::MatrixXd Omega = c1 * (F1 + F2) + c2 * (F2 * F1 - F1 * F2);
+      Phi = Eigen::MatrixXd(Omega.exp()) * Phi;
+    }
+    return Phi;
+  };
+  const Eigen::MatrixXd coarse = product(steps), fine = product(2 * steps);
+  Eigen::MatrixXd Phi = fine + (fine - coarse) / 15.0;
+  if (!Phi.allFinite()) throw NumericalError("the product of matrix exponentials overflowed");
+  return Phi;
 }
 
 Eigen::MatrixXd state_matrix_at(const MimoModel& m, double t) {

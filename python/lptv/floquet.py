@@ -173,8 +173,12 @@ def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
         period=model.period if not model.discrete else model.samples_per_period * model.ts)
 
 
-def monodromy(model: Model, steps: Optional[int] = 2000) -> np.ndarray:
+def monodromy(model, steps: Optional[int] = 2000) -> np.ndarray:
     """The monodromy matrix Phi (na x na) by a route independent of Hill's method, for checks.
+
+    An :class:`lptv.MimoModel` gives the monodromy matrix of its state form (the observer form
+    of METHOD.md section 19, sum_p d_p square) by the same products; its eigenvalues are the
+    multipliers of :func:`floquet`.
 
     Continuous time: the product of the matrix exponentials of a fourth-order Magnus step over
     ``steps`` equal sub-intervals of one period (F(t) evaluated from the coefficients at the two
@@ -191,9 +195,10 @@ def monodromy(model: Model, steps: Optional[int] = 2000) -> np.ndarray:
     >>> bool(np.isclose(monodromy(m)[0, 0], np.exp(-4 * np.pi), rtol=1e-12))
     True
     """
-    _check_model(model)
+    _check_model(model, mimo=True)
     steps = 0 if model.discrete else as_int(steps, "steps", minimum=1)
-    return np.asarray(_core.monodromy(model._cpp, steps))
+    route = _core.monodromy_mimo if isinstance(model, MimoModel) else _core.monodromy
+    return np.asarray(route(model._cpp, steps))
 
 
 # The stability check of simulate and identify runs on every estimate, including over-fitted,

@@ -21,6 +21,7 @@ from scipy.linalg import eig
 from scipy.optimize import linear_sum_assignment
 
 import lptv
+from lptv.floquet import monodromy
 from conftest import (MIMO_FLOQUET_DT, MIMO_FLOQUET_IVP_RTOL, MIMO_FLOQUET_KAPPA_MAX, MIMO_FLOQUET_MARGIN,
                       MIMO_FLOQUET_SISO, MIMO_FLOQUET_VS_IVP, MIMO_FROZEN_POLES, SEEDS)
 
@@ -118,6 +119,9 @@ def test_mechanical_systems_with_a_periodic_mass_against_solve_ivp(seed, ny):
         err, rho = check_against(f, Phi)
         assert err <= MIMO_FLOQUET_VS_IVP, err
         verdicts.add(f.is_stable)
+        # the core's product route (its observer-form state: Phi up to a similarity)
+        products = np.linalg.eigvals(monodromy(model))
+        assert matching(products, np.linalg.eigvals(Phi)) <= MIMO_FLOQUET_VS_IVP * np.linalg.norm(Phi, 2)
     assert verdicts == {True, False}
 
 

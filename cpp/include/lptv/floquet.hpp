@@ -70,6 +70,11 @@ Floquet floquet(const MimoModel& m, const FloquetOptions& opt = FloquetOptions()
 // The row degrees d_p of A(t, s): the highest order with a nonzero coefficient in row p.
 std::vector<int> row_degrees(const MimoModel& m);
 
+// The monodromy matrix of that state form by products, for checks (as monodromy(const Model&)):
+// continuous time `steps` fourth-order Magnus steps and 2 steps, extrapolated; discrete time the
+// product of the N one-step matrices (`steps` ignored). sum_p d_p square.
+Eigen::MatrixXd monodromy(const MimoModel& m, int steps);
+
 // The state matrix of that form at time t (continuous time: x' = F(t) x) or the one-step
 // matrix of sample t / ts (discrete time: x[k+1] = G[k] x[k]); sum_p d_p square.
 Eigen::MatrixXd state_matrix_at(const MimoModel& m, double t);
