@@ -210,12 +210,13 @@ CHECK_MAX_STEPS = 4096
 CHECK_MAX_HILL = 400
 
 
-def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
+def stability_check(model) -> Tuple[Optional[str], Optional[str]]:
     """``(unstable, undecided)``: a sentence when ``model`` is unstable beyond its multipliers'
     error (else None), and a sentence when the check could not decide within its cost bound
     (else None); at most one of the two is set.
 
-    LTI models: the roots of a(s) (a(z)). LPTV models: the monodromy matrix by products
+    LTI models: the roots of a(s) (a(z)). A :class:`lptv.MimoModel`: :func:`floquet` with Hill's
+    matrix at most ``CHECK_MAX_HILL`` rows (discrete time: the exact product). LPTV models: the monodromy matrix by products
     (:func:`monodromy` with 32, 64, ... up to ``CHECK_MAX_STEPS`` steps, until two successive
     spectral radii differ by less than a tenth of their distance to 1: under a millisecond on
     the paper's model), then :func:`floquet` with Hill's matrix at most ``CHECK_MAX_HILL`` rows.
@@ -243,7 +244,9 @@ def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
         return cached[1]
     undecided = None
     try:
-        if model.is_lti:
+        if isinstance(model, MimoModel):
+            text, undecided = _mimo_stability(model)
+        elif model.is_lti:
             text = _lti_unstable_text(model)
         else:
             text, undecided = _lptv_stability(model)
@@ -254,6 +257,25 @@ def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
                  "from rest never settles into it")
     model.__dict__["_stability"] = (model._cpp, (text, undecided))
     return text, undecided
+
+
+def _mimo_stability(model: MimoModel) -> Tuple[Optional[str], Optional[str]]:
+    # Hill's method (or the exact product in discrete time) with its matrix at most
+    # CHECK_MAX_HILL rows: the state has sum_p d_p components.
+    n = int(sum(_core.mimo_row_degrees(model._cpp)))
+    try:
+        f = floquet(model, max_truncation=max(1, (CHECK_MAX_HILL // max(n, 1) - 1) // 2))
+    except _core.NumericalError as err:
+        return None, (f"stability not decided within the check's cost bound: Hill's method did not "
+                      f"converge ({err}); lptv.floquet(model, max_truncation=...) can try harder")
+    if f.multipliers.size == 0:
+        return None, None
+    k = int(np.argmax(np.abs(f.multipliers)))
+    mu, err = abs(f.multipliers[k]), f.error_estimate[k]
+    if mu > 1.0 and (mu - 1.0) > err * max(mu, 1.0):
+        return (f"the model is unstable (Floquet multiplier of magnitude {mu:.6g} > 1, "
+                f"Floquet exponent with real part {f.exponents[k].real:.6g} 1/s)"), None
+    return None, None
 
 
 def unstable_warning_text(model: Model) -> Optional[str]:

@@ -162,6 +162,25 @@ CT_MEANS = dict(al=0.2, f=0.3, e=0.8, h=0.4, g=0.3, k=4.0, c=0.4)
 DT_MEANS = dict(al=0.1, f=0.1, e=-0.5, h=0.1, g=0.1, k=0.81, c=-1.2)     # roots near 0.9 exp(+-0.73j), 0.5
 
 
+def test_simulate_warns_for_an_unstable_matrix_model():
+    """simulate's stability check (lptv.floquet.stability_check) on the pumped two masses: the
+    periodic solution is returned either way, with UnstableModelWarning above the tongue's edge."""
+    import warnings
+
+    U = np.zeros((40, 2), complex)
+    U[7] = [0.5, 0.2j]
+    for depth, unstable in ((0.05, False), (0.4, True)):
+        model, _ = two_mass(depth)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            Y = lptv.simulate(model, U)
+            lptv.simulate(model, U, warn_unstable=False)
+        found = [w for w in caught if issubclass(w.category, lptv.UnstableModelWarning)]
+        assert len(found) == unstable and Y.shape == (40, 2)
+        if unstable:
+            assert "Floquet multiplier of magnitude 1.0272" in str(found[0].message)
+
+
 def mixed_degrees(seed, w0=1.0, ts=None, **means):
     """Row 1: y1'' + al(t) y2'' + c y1' + k(t) y1 + g(t) y2 = 0; row 2: y2' + f(t) y1' + e(t) y2
     + h(t) y1 = 0 (row degrees 2 and 1, A_2 = [[1, al], [0, 0]] singular, L = [[1, al], [f, 1]]);
