@@ -242,3 +242,28 @@ TEST_CASE("several outputs: a singular leading row coefficient matrix is refused
   a(0, 1) = a(3, 1) = 0.3;
   REQUIRE_THROWS_AS(lptv::floquet(lptv::MimoModel(a, b, 2, 1, 1.0)), std::invalid_argument);
 }
+
+TEST_CASE("several outputs: Hill's multipliers are the eigenvalues of the products", "[floquet][mimo]") {
+  // Two masses, M = diag(1, 2), C = 0.02 M, coupling spring 2 (1 + depth cos(w0 t)) pumped at
+  // w0 = 2 w_1 = 2.8917: stable at depth 0.05, unstable at 0.4.
+  for (double depth : {0.05, 0.4}) {
+    Eigen::MatrixXcd a = Eigen::MatrixXcd::Zero(3 * 4, 3), b = Eigen::MatrixXcd::Zero(4, 1);
+    const double K[2][2] = {{7.0, -2.0}, {-2.0, 5.0}}, S[2][2] = {{1.0, -1.0}, {-1.0, 1.0}};
+    for (int p = 0; p < 2; ++p) {
+      for (int q = 0; q < 2; ++q) {
+        a(p * 2 + q, 1) = K[p][q];
+        a(p * 2 + q, 0) = a(p * 2 + q, 2) = depth * S[p][q];
+      }
+      a(4 + p * 3, 1) = 0.02 * (p + 1);
+      a(8 + p * 3, 1) = 1.0 * (p + 1);
+      b(p * 3, 0) = 1.0;
+    }
+    const double w1 = std::sqrt((19.0 - std::sqrt(113.0)) / 4.0);
+    const lptv::MimoModel m(a, b, 2, 2, 2 * w1);
+    const auto f = lptv::floquet(m);
+    const Eigen::MatrixXd Phi = lptv::monodromy(m, 2000);
+    REQUIRE(f.multipliers.size() == 4);
+    REQUIRE(distance_to_eig(f.multipliers, Phi) <= 1e-10 * Phi.norm());
+    REQUIRE(f.is_stable == (depth < 0.1));
+  }
+}
