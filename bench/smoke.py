@@ -51,6 +51,8 @@ SMOKE = {
     "bench_htf_overlap.py": ["1"],
     "bench_identifiability.py": ["2"],
     "bench_inspect.py": ["--runs", "12"],
+    "bench_mimo.py": ["--runs", "3", "--systems", "2-in-1-out"],
+    "bench_mimo_cost.py": ["--rounds", "1", "--n", "64"],
     "bench_ml_lti.py": ["--rounds", "1", "--inner", "1", "--fditools", ""],
     "bench_moderation_core.py": ["1"],
     "bench_multi_experiment.py": ["3"],

@@ -5,7 +5,8 @@ The public API:
 - :class:`Model` - the LPTV model (and LTI as its special case), JSON save/load;
 - :class:`MimoModel`, :func:`mimo_multisines`, :func:`mimo_htf_estimate` - several inputs and
   outputs: the matrix model (simulated by :func:`simulate`), the experiments' multisines and the
-  nonparametric HTF matrix from them;
+  nonparametric HTF matrix from them; :class:`MimoFrequencyData`, :func:`mimo_crb` and
+  :func:`identify` on (P, N, nu) / (P, N, ny) arrays for their estimation;
 - :func:`multisine`, :func:`spectrum`, :func:`time_signal` - excitation and spectra;
 - :func:`min_crest_multisine`, :func:`schroeder_multisine`, :func:`excitation_lines`,
   :func:`multisine_realisations` - excitation design (crest factor, detection lines, realisations);
@@ -41,6 +42,9 @@ from .model import Model
 from .mimo import MimoModel
 from .mimo_multisine import MimoMultisines, mimo_multisines
 from .mimo_htf import MimoHtfEstimate, mimo_htf_estimate
+from .mimo_data import MimoFrequencyData
+from .mimo_result import MimoIdentificationResult
+from .mimo_identify import MimoCramerRaoBound, mimo_crb
 from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
@@ -62,4 +66,5 @@ __all__ = [
     "schroeder_multisine", "RecordResult", "identify_record", "ModeratedNoise", "moderated_noise",
     "Disturbance", "DisturbanceResult", "disturbances", "Inspection", "LineClass", "inspect",
     "MimoModel", "MimoMultisines", "mimo_multisines", "MimoHtfEstimate", "mimo_htf_estimate",
+    "MimoFrequencyData", "MimoIdentificationResult", "MimoCramerRaoBound", "mimo_crb",
 ]

@@ -12,6 +12,7 @@ from .data import FrequencyData, experiments_of, frequency_data_of
 from .floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
 from .model import Model
 from ._validate import INT_MAX, as_counts, as_float, as_int, as_lines
+from .mimo_identify import identify_mimo, is_mimo
 from .result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
@@ -91,8 +92,21 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
              kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
              lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
              max_iter: int = 50, covariance: str = "analytic", bootstrap: int = 200,
-             seed=None, noise: str = "sample", disturbances: Optional[str] = None) -> IdentificationResult:
+             seed=None, noise: str = "sample", disturbances: Optional[str] = None):
     """Estimate an LPTV model from noisy input/output periods.
+
+    Several inputs and outputs (METHOD.md section 19): ``u`` of shape (P, N, nu) and ``y`` of
+    shape (P, N, ny) (3-D arrays, also for one channel), or a list of (u, y) pairs of such
+    arrays (or :class:`lptv.MimoFrequencyData`) for several experiments, give a
+    :class:`lptv.mimo_result.MimoIdentificationResult` whose ``model`` is a :class:`MimoModel`
+    normalised to A_na,0 = I. ``ka`` is then an int for every entry of every A_n, one count
+    per order (na+1,), per entry (ny, ny) or per order and entry (na+1, ny, ny), row-uniform
+    (each column's entries with the same count in every row); ``kb`` likewise with (ny, nu).
+    Methods 'gtls', 'wgtls' (vector residues weighted by their covariance matrices) and 'sml'
+    (the exact likelihood of the rows); covariance 'analytic' (SML: the inverse Fisher
+    information; WGTLS: the first-order sandwich; both times (P-1)/(P-3)) or 'none';
+    ``lines`` None (every usable line K+1..N/2-K), 'excited', a sequence, or one entry per
+    experiment. 2-D arrays stay the single-input single-output fit below.
 
     Parameters
     ----------
@@ -210,6 +224,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     >>> np.round(res.model.a[:, 0].real, 2)
     array([2., 1.])
     """
+    if is_mimo(u, y):
+        if noise != "sample" or disturbances is not None:
+            raise ValueError("noise and disturbances: only noise='sample' and disturbances=None are built for "
+                             "several inputs or outputs")
+        return identify_mimo(u, y, na=na, nb=nb, ka=ka, kb=kb, w0=w0, ts=ts, lines=lines, method=method,
+                             known=known, tol=tol, max_iter=max_iter, covariance=covariance)
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if not isinstance(covariance, str) or covariance not in COVARIANCES:

@@ -1,0 +1,240 @@
+"""Estimation with several inputs and outputs (METHOD.md section 19): lptv.identify on (P, N, nu)
+and (P, N, ny) arrays against the dense reference lptv.reference.mimo_fit (WGTLS, SML, the
+covariances, the CRB), against systems integrated by solve_ivp (noise-free data give the true
+coefficients), against the single-input single-output fit (a 1 x 1 fit is the SISO fit), and its
+refusals of bad arguments."""
+import warnings
+
+import numpy as np
+import pytest
+
+import lptv
+from lptv import mimo_examples as mx
+from lptv.mimo_data import MimoFrequencyData
+from lptv.reference import mimo_fit as ref
+
+N = 32
+LINES = np.arange(2, 14, 2)
+STRUCTURE = {"2-in-2-out": dict(na=2, nb=0, ka=[1, 0, 0], kb=0), "1-in-2-out": dict(na=2, nb=0, ka=[1, 0, 0], kb=0),
+             "2-in-1-out": dict(na=2, nb=1, ka=[1, 0, 0], kb=[1, 0])}
+
+
+def experiments(system, seed, P=6, level=0.03, n=N, lines=LINES):
+    """Orthogonal (Hadamard) experiments, E = nu, of a system's FDS steady state plus white noise
+    of ``level`` times each channel's rms on every input and output sample."""
+    model = mx.SYSTEMS[system]()[0]
+    rng = np.random.default_rng(seed)
+    d = lptv.mimo_multisines(lines, n, model.n_inputs, seed=rng)
+    out = []
+    for e in range(d.n_experiments):
+        U = d.spectra[e]
+        Y = np.asarray(lptv.simulate(model, U, lines_out=n // 2)).reshape(n // 2 + 1, -1)
+        y1 = np.fft.irfft(Y * n, n, axis=0)
+        u1 = d.signals[e]
+        u = u1[None] + level * u1.std(axis=0) * rng.standard_normal((P, n, u1.shape[1]))
+        y = y1[None] + level * y1.std(axis=0) * rng.standard_normal((P, n, y1.shape[1]))
+        out.append((u, y))
+    return model, out
+
+
+def reference_data(pairs, K, n=N):
+    out = []
+    for u, y in pairs:
+        d = MimoFrequencyData.from_periods(u, y, w0=mx.W0)
+        out.append((d.Y, d.U, d.C, np.arange(K + 1, n // 2 - K + 1)))
+    return out
+
+
+def counts(k, order, cols):
+    """An int or one count per order as (order+1, cols)."""
+    k = np.asarray(k)
+    return np.broadcast_to(k[:, None] if k.ndim == 1 else k, (order + 1, cols)).copy()
+
+
+def ref_structure(system):
+    s = STRUCTURE[system]
+    model = mx.SYSTEMS[system]()[0]
+    ny, nu = model.n_outputs, model.n_inputs
+    return ref.Structure(s["na"], s["nb"], counts(s["ka"], s["na"], ny), counts(s["kb"], s["nb"], nu), mx.W0)
+
+
+@pytest.mark.parametrize("system", list(mx.SYSTEMS))
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_wgtls_matches_reference(system, seed):
+    model, pairs = experiments(system, seed)
+    res = lptv.identify(pairs, w0=mx.W0, method="wgtls", tol=1e-12, max_iter=100, **STRUCTURE[system])
+    st = ref_structure(system)
+    xi_ref, _ = ref.wgtls(st, reference_data(pairs, st.K), tol=1e-12, max_iter=100)
+    assert res.converged
+    # both iterate to a relative change of 1e-12; the fixed point is a smooth function of the
+    # weights, so the two agree to that times the iteration's contraction (measured < 10) and the
+    # rounding of the eigenproblems (eps times the generalised condition, < 1e6 here)
+    err = np.abs(res.eta - xi_ref).max() / np.abs(xi_ref).max()
+    assert err < 1e-9, err
+
+
+@pytest.mark.parametrize("system", list(mx.SYSTEMS))
+@pytest.mark.parametrize("seed", [0, 1])
+def test_sml_and_covariances_match_reference(system, seed):
+    model, pairs = experiments(system, seed)
+    res = lptv.identify(pairs, w0=mx.W0, method="sml", tol=1e-12, **STRUCTURE[system])
+    st = ref_structure(system)
+    data = reference_data(pairs, st.K)
+    xi_w, _ = ref.wgtls(st, data)
+    xi_ref, out = ref.sml(st, data, xi_w)
+    std = res.parameter_std / np.sqrt(res.covariance_factor)
+    free = st.free
+    # the two optimisers stop at a gradient of about 1e-10 relative: well inside 1e-4 standard deviations
+    assert np.abs(res.eta - xi_ref)[free].max() <= 1e-4 * std[free].min(), np.abs(res.eta - xi_ref)[free] / std[free]
+    # the cost is at its minimum on both routes: the reference's at the production's estimate is no lower
+    assert ref._cost_grad(st, res.eta, data)[0] <= ref._cost_grad(st, xi_ref, data)[0] * (1 + 1e-10)
+    # the Fisher information and the sandwich at the same estimate (pure linear algebra: rounding only)
+    cov_ref = np.linalg.inv(ref.fisher(st, res.eta, data))
+    cov = res.covariance[np.ix_(free, free)] / res.covariance_factor
+    assert np.allclose(cov, cov_ref, rtol=1e-8, atol=1e-10 * np.abs(cov_ref).max())
+    from lptv.mimo_fit import prepare, sandwich
+    from lptv.mimo_data import MimoStructure
+    datas = [MimoFrequencyData.from_periods(u, y, w0=mx.W0) for u, y in pairs]
+    ny, nu = model.n_outputs, model.n_inputs
+    s = STRUCTURE[system]
+    mst = MimoStructure(s["na"], s["nb"], st.ka, st.kb, ny, nu, mx.W0)
+    sw = sandwich(prepare(datas, mst, [r for *_, r in data]), mst, res.eta)
+    sw_ref = ref.sandwich(st, res.eta, data)
+    assert np.allclose(sw, sw_ref, rtol=1e-8, atol=1e-10 * np.abs(sw_ref).max())
+
+
+@pytest.mark.parametrize("system", list(mx.SYSTEMS))
+def test_crb_matches_reference(system):
+    model, pairs = experiments(system, 0)
+    d = lptv.mimo_multisines(LINES, N, model.n_inputs, seed=np.random.default_rng(0))
+    noise = np.r_[np.full(model.n_outputs, 1e-4), np.full(model.n_inputs, 1e-5)]
+    P = 8
+    bound = lptv.mimo_crb(model, d.spectra, noise=noise, periods=P, ka=STRUCTURE[system]["ka"],
+                          kb=STRUCTURE[system]["kb"])
+    st = ref_structure(system)
+    a, b = mx.true_parameters(model)
+    assert np.allclose(st.coefficients(bound.eta)[0][(st.na, 0, 0)][0], 1.0)
+    data = []
+    for e in range(d.n_experiments):
+        U = d.spectra[e]
+        Y = np.asarray(lptv.simulate(model, U, lines_out=N // 2)).reshape(N // 2 + 1, -1)
+        C = np.broadcast_to(np.diag(noise.astype(complex)) / P, (N // 2 + 1,) + (noise.size,) * 2)
+        data.append((Y, U, np.array(C), np.arange(st.K + 1, N // 2 - st.K + 1)))
+    crb_ref = ref.crb(st, bound.eta, data)
+    cov = bound.covariance[np.ix_(st.free, st.free)]
+    assert np.allclose(cov, crb_ref, rtol=1e-8, atol=1e-10 * np.abs(crb_ref).max())
+    # and the normalised true parameters are the model's own coefficients times A_na,0^-1
+    ra, rb = st.coefficients(bound.eta)
+    Ka = a.shape[3] // 2
+    for (n, p, q), v in ra.items():
+        for k, c in v.items():
+            assert abs(c - a[n, p, q, Ka + k]) < 1e-14
+
+
+@pytest.mark.parametrize("system", list(mx.SYSTEMS))
+def test_noise_free_solve_ivp_gives_true_coefficients(system):
+    model = mx.SYSTEMS[system]()[0]
+    n = 64
+    lines = np.arange(2, 30, 3)
+    d = lptv.mimo_multisines(lines, n, model.n_inputs, design="random", n_experiments=max(2, model.n_inputs),
+                             seed=3)
+    pairs = []
+    for e in range(d.n_experiments):
+        y1 = mx.steady_state(system, d.spectra[e], n)
+        pairs.append((np.repeat(d.signals[e][None], 2, axis=0), np.repeat(y1[None], 2, axis=0)))
+    res = lptv.identify(pairs, w0=mx.W0, **STRUCTURE[system])
+    assert res.noise_free and res.covariance is None and res.model_ok is None
+    a, b = mx.true_parameters(model)
+    s = STRUCTURE[system]
+    ny, nu = model.n_outputs, model.n_inputs
+    from lptv.mimo_data import MimoStructure
+    st = MimoStructure(s["na"], s["nb"], counts(s["ka"], s["na"], ny), counts(s["kb"], s["nb"], nu), ny, nu, mx.W0)
+    truth = st.xi_of(a, b)
+    # the integration's relative error (about 1e-13 of the largest output line, bounded by 10 rtol
+    # in test_mimo_timedomain) times the condition of the TLS problem: the ratio of the largest
+    # to the (ny^2 + 1)-th singular value of the scaled Jacobian, under 1e4 here
+    sv = res.singular_values
+    cond = sv[-1] / sv[ny * ny]
+    assert cond < 1e4
+    err = np.abs(res.eta - truth).max() / np.abs(truth).max()
+    assert err < 10 * mx.RTOL * cond * 10, (err, cond)
+
+
+@pytest.mark.parametrize("method", ["wgtls", "sml"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_one_by_one_equals_siso(method, seed):
+    m = lptv.Model([[0.5, 2.0, 0.5], [0.0, 1.0, 0.0]], [[0.0, 1.0, 0.0]], w0=1.0)
+    ms = lptv.multisine(range(2, 30), 128, seed=seed)
+    y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 128)
+    rng = np.random.default_rng(seed)
+    P = 6
+    u = ms.periods(P) + 0.02 * rng.standard_normal((P, 128))
+    y = np.tile(y1, (P, 1)) + 0.02 * rng.standard_normal((P, 128))
+    kw = dict(na=1, nb=0, ka=1, kb=0, w0=1.0, method=method, tol=1e-13, max_iter=200)
+    siso = lptv.identify(u, y, **kw)
+    mimo = lptv.identify(u[:, :, None], y[:, :, None], **kw)
+    assert isinstance(mimo, lptv.MimoIdentificationResult)
+    assert mimo.model.n_inputs == mimo.model.n_outputs == 1
+    assert np.abs(mimo.eta - siso.eta).max() <= 1e-8 * np.abs(siso.eta).max() + 1e-6 * siso.parameter_std.min()
+    if method == "sml":   # the same Fisher information and factor (P-1)/(P-3); WGTLS's SISO covariance adds a
+        # second-order term the MIMO sandwich leaves out
+        assert np.allclose(mimo.covariance, siso.covariance, rtol=1e-6, atol=1e-12)
+    assert np.allclose(mimo.model.a[:, 0, 0], siso.model.a, rtol=1e-8, atol=1e-9)
+
+
+def test_result_interface():
+    model, pairs = experiments("2-in-2-out", 4, P=8)
+    res = lptv.identify(pairs, w0=mx.W0, method="sml", **STRUCTURE["2-in-2-out"])
+    assert (res.model.n_inputs, res.model.n_outputs) == (2, 2)
+    assert res.eta.shape == res.parameter_std.shape == (len(res.parameter_names),)
+    assert res.covariance.shape == (res.eta.size,) * 2
+    ci = res.confidence_interval(0.9)
+    assert ci.shape == (res.eta.size, 2) and np.all(ci[:, 0] <= ci[:, 1])
+    assert res.converged and np.isfinite(res.cost) and res.lines.size > 0
+    assert isinstance(res.verdict, str) and isinstance(res.model_errors, list)
+    assert res.model_ok in (True, False)
+    assert res.parameter_names[0] == "a0[0,0].re0"
+    fixed = [i for i, nm in enumerate(res.parameter_names) if nm.startswith("a2[") and nm.endswith(".re0")]
+    assert np.allclose(res.eta[fixed], [1, 0, 0, 1]) and np.all(res.parameter_std[fixed] == 0)
+    # one experiment of a (P, N, nu) pair, the wrong structure (no time variation) is rejected
+    bad = lptv.identify(pairs, w0=mx.W0, method="wgtls", na=2, nb=0, ka=0, kb=0)
+    assert bad.model_ok is False and bad.model_errors and bad.verdict.startswith("model error")
+
+
+def _pairs():
+    return experiments("2-in-2-out", 5, P=4)[1]
+
+
+@pytest.mark.parametrize("call, word", [
+    (lambda p: lptv.identify(p[0][0], p[0][1][:, :, 0], na=2, nb=0, w0=1.0), "y"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, ka=np.ones((4, 2))), "ka"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, ka=[[0, 1], [1, 1]]), "ka"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, kb=-1), "kb"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, method="ls"), "method"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, known={"a2": 1.0}), "known"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, ka=1, lines=[1, 2, 3]), "lines"),
+    (lambda p: lptv.identify(p, na=2, nb=0), "w0"),
+    (lambda p: lptv.identify(p[0][0][:1], p[0][1][:1], na=2, nb=0, w0=1.0), "u"),
+    (lambda p: lptv.identify([p[0], (p[1][0][:, :, :1], p[1][1])], na=2, nb=0, w0=1.0), "experiments[1]"),
+    (lambda p: lptv.identify(p, na=2, nb=0, w0=1.0, covariance="bootstrap"), "covariance"),
+    (lambda p: lptv.identify(p[0][0], p[0][1] * np.nan, na=2, nb=0, w0=1.0), "y"),
+    (lambda p: lptv.identify(p, na="x", nb=0, w0=1.0), "na"),
+    (lambda p: lptv.mimo_crb("m", p[0][0], noise=1.0, periods=2), "model"),
+])
+def test_bad_inputs_name_the_argument(call, word):
+    p = _pairs()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(ValueError, match=r"^" + word.replace("[", r"\[").replace("]", r"\]")):
+            call(p)
+
+
+def test_docstring_examples_run():
+    import doctest
+    import lptv.mimo_data
+    import lptv.mimo_examples
+    import lptv.mimo_identify
+    import lptv.mimo_result
+    for mod in (lptv.mimo_data, lptv.mimo_examples, lptv.mimo_identify, lptv.mimo_result):
+        result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
+        assert result.attempted > 0 and result.failed == 0, mod.__name__
