@@ -96,7 +96,7 @@ def add_parser(sub):
                "  lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
                "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2\n"
                "  lptv identify low.npz high.npz --joint --na 2 --nb 1 --method sml\n"
-               "  lptv identify e1.csv e2.csv --input f1,f2 --output x1,x2 --period 6.28 --na 2 --nb 0 --ka 1")
+               "  lptv identify e1.csv e2.csv --input f1,f2 --output x1,x2 --w0 1 --na 2 --nb 0 --ka 1,0,0")
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurements: .csv, .npz or .mat; several files are fitted as a batch")
     p.add_argument("--na", type=int, required=True, help="order of the output side")

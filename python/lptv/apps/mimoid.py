@@ -13,7 +13,7 @@ report.html yet. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4
 
 Example::
 
-    lptv identify exp1.csv exp2.csv --input f1,f2 --output x1,x2 --period 6.283 --na 2 --nb 0 --ka 1
+    lptv identify exp1.csv exp2.csv --input f1,f2 --output x1,x2 --w0 1 --na 2 --nb 0 --ka 1,0,0
 """
 from __future__ import annotations
 
