@@ -118,6 +118,8 @@ def test_the_command_gives_the_python_api_model_and_accepts_the_right_structure(
     assert "2 experiments, 2 inputs (F1 [N], f2 [N]), 2 outputs (x1 [m], x2 [m])" in out.splitlines()[0]
     assert "verdict: consistent" in out
     res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0, method=method)
+    f = lptv.floquet(res.model)
+    assert f"stability: stable: 4 Floquet multipliers, the largest of magnitude {f.spectral_radius:.6g}" in out
     model = lptv.MimoModel.load(tmp_path / "o" / "model.json")
     np.testing.assert_allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
     np.testing.assert_allclose(model.b, res.model.b, rtol=0, atol=1e-10 * np.abs(res.model.b).max())
@@ -125,6 +127,14 @@ def test_the_command_gives_the_python_api_model_and_accepts_the_right_structure(
     assert summary["inputs"] == ["F1 [N]", "f2 [N]"] and summary["model_ok"] is True
     assert [p["name"] for p in summary["parameters"]] == list(res.parameter_names)
     std = np.array([p["std"] for p in summary["parameters"]])
+    # the estimate's multipliers: with M^-1 C = I, y = exp(-t/2) z turns the system into an
+    # undamped one (z'' + (M^-1 K(t) - I/4) z = 0, away from its resonances), whose multipliers
+    # lie on the unit circle: every |mu| is exp(-T0/2). The estimate's ln|mu| moves by T0 times
+    # the change of the damping's eigenvalues, at most that of M^-1 C's entries: 5 std of them.
+    assert summary["stability"]["is_stable"] is True
+    ln_rho = np.log(summary["stability"]["spectral_radius"])
+    damping_std = max(s for n, s in zip(res.parameter_names, std) if n.startswith("a1"))
+    assert abs(ln_rho + 0.5 * T0) <= 5 * T0 * damping_std, (ln_rho + 0.5 * T0, damping_std)
     np.testing.assert_allclose(std, res.parameter_std, rtol=1e-8)
     # every estimate against the system integrated by solve_ivp, within 5 standard deviations
     free = std > 0

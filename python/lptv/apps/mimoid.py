@@ -7,8 +7,8 @@ period), fitted together into one :class:`lptv.MimoModel` by :func:`lptv.identif
 of (u, y) pairs, u of shape (P, N, nu) and y (P, N, ny) (METHOD.md section 19); ``--joint`` says
 the same and may be given. A single file is one experiment (enough for one input, or when the
 inputs excite different lines). Writes ``model.json`` (:meth:`lptv.MimoModel.load`) and
-``summary.json``, prints the parameters with their standard deviations and the verdict; no
-report.html yet. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4 no verdict,
+``summary.json``, prints the parameters with their standard deviations, the verdict and the
+estimate's stability (its Floquet multipliers); no report.html yet. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4 no verdict,
 2 a file or option that cannot be used (a one-line error), 1 a computation that failed.
 
 Example::
@@ -154,13 +154,31 @@ def run(args) -> int:
     for e, (src, meas) in enumerate(records):
         print(f"  #{e} {src} ({meas.format}): {meas.u.shape[0]} periods of {meas.u.shape[1]} samples")
     print(text_summary(res))
+    stability = stability_of(res.model)
+    print(f"stability: {stability['text']}")
     for msg in list(getattr(res, "warnings", ())) + notes:
         print(f"warning: {msg}")
     summary = json_summary(args, records, w0, ts, ka, kb, res, notes)
+    summary["stability"] = {k: v for k, v in stability.items() if k != "text"}
     failed = write_fit(out, res.model, summary, None)
     if failed:
         return _fail(failed[1] if failed[0] is None else f"{failed[0]}: {failed[1]}")
     return status_of(res)
+
+
+def stability_of(model) -> dict:
+    """The Floquet multipliers of the estimate (:func:`lptv.floquet` of the matrix system) as
+    plain values, with a sentence; ``is_stable`` None when they could not be computed."""
+    try:
+        f = lptv.floquet(model)
+    except (ValueError, NumericalError) as e:
+        return {"is_stable": None, "spectral_radius": None, "multipliers": None,
+                "text": f"not decided ({' '.join(str(e).split())})"}
+    word = "stable" if f.is_stable else "NOT stable"
+    return {"is_stable": bool(f.is_stable), "spectral_radius": float(f.spectral_radius),
+            "multipliers": [[float(m.real), float(m.imag)] for m in f.multipliers],
+            "text": f"{word}: {f.multipliers.size} Floquet multipliers, the largest of magnitude "
+                    f"{f.spectral_radius:.6g} (lptv.floquet)"}
 
 
 def status_of(res) -> int:
