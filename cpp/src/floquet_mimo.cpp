@@ -40,9 +40,9 @@ Layout layout_of(const MimoModel& m) {
           if (m.a_coef(n, p, q, k) != cd(0.0, 0.0)) s.d[p] = std::max(s.d[p], n);
   for (int p = 0; p < s.ny; ++p) {
     if (s.d[p] < 0) {
-      throw std::invalid_argument("a: row " + std::to_string(p) +
-                                  " of A(t, s) is zero at every order: output " + std::to_string(p) +
-                                  " has no equation, the matrix system is singular");
+      throw std::invalid_argument("a: row " + std::to_string(p) + " of A(t, s) is zero at every order (output " +
+                                  std::to_string(p) +
+                                  " has no equation); every row must hold a nonzero coefficient");
     }
     s.offset[p] = s.n;
     s.n += s.d[p];

@@ -115,8 +115,8 @@ def _frozen_poles_mimo(model: MimoModel, t: np.ndarray) -> np.ndarray:
     ny = model.n_outputs
     d = model.na_entries.max(axis=1)  # row degrees; -1: a zero row
     if np.any(d < 0):
-        raise ValueError(f"model: row {int(np.argmax(d < 0))} of A(t, s) is zero at every order; "
-                         "det A(t, s) vanishes identically")
+        raise ValueError(f"model: row {int(np.argmax(d < 0))} of A(t, s) is zero at every order (det A(t, s) "
+                         "vanishes identically); every row must hold a nonzero coefficient")
     off = np.concatenate([[0], np.cumsum(d)])
     n = int(off[-1])
     out = np.full((t.size, n), complex(np.inf, 0.0))
