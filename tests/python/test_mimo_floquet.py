@@ -343,6 +343,26 @@ def test_a_one_by_one_model_has_the_siso_multipliers(seed):
     assert matching(lptv.floquet(lti).multipliers, exact) <= MIMO_FLOQUET_SISO * np.abs(exact).max()
 
 
+def test_decoupled_identical_channels_have_each_multiplier_twice():
+    """diag(m, m) for the Mathieu equation above and below its tongue's edge, and an LTI system
+    with a double pole per channel pair: Hill's matrix has every eigenvalue twice, and both
+    copies of each family are kept (METHOD.md section 12: two eigenpairs at one centroid are two
+    exponents)."""
+    from lptv.examples import mathieu_model
+
+    for eps in (0.1, 0.06):
+        s = mathieu_model(eps=eps)
+        a = np.zeros((3, 2, 2, s.a.shape[1]), complex)
+        a[:, 0, 0], a[:, 1, 1] = s.a, s.a
+        f, g = lptv.floquet(lptv.MimoModel(a, np.ones((1, 2, 1)), w0=s.w0)), lptv.floquet(s)
+        assert f.is_stable == g.is_stable
+        twice = np.repeat(g.multipliers, 2)
+        assert matching(f.multipliers, twice) <= MIMO_FLOQUET_SISO * 10 + 4 * g.error_estimate.max()
+    lti = lptv.MimoModel(np.stack([2 * np.eye(2), 3 * np.eye(2), np.eye(2)]), np.ones((1, 2, 1)), w0=1.0)
+    exact = np.exp(np.array([-1.0, -1.0, -2.0, -2.0]) * lti.period)     # s^2 + 3 s + 2 = (s + 1)(s + 2)
+    assert matching(lptv.floquet(lti).multipliers, exact) <= MIMO_FLOQUET_SISO * exact.max()
+
+
 # ------------------------------------------------------------------------------ frozen poles
 
 def poly_of(entry_coeffs):
