@@ -151,6 +151,28 @@ def test_a_missing_harmonic_is_a_model_error(files, tmp_path, capsys):
     assert "verdict: model error" in out
 
 
+@needs_fit
+def test_npz_periods_with_a_stored_fs_and_a_discrete_time_model(experiments, tmp_path, capsys):
+    """(P, N) arrays per channel with fs stored and no period: w0 = 2 pi fs / N from one
+    channel's periods; --discrete takes ts = 1 / fs and fits the model in the shift, as
+    lptv.identify does on the same arrays with that ts."""
+    files = []
+    for e, (u, y) in enumerate(experiments):
+        files.append(tmp_path / f"e{e}.npz")
+        np.savez(files[-1], f1=u[..., 0], f2=u[..., 1], x1=y[..., 0], x2=y[..., 1], fs=N / T0)
+    argv = ["--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb", "2", "--ka", "1,0,0"]
+    rc, out, err = identify_cli(capsys, *files, *argv, "--out", tmp_path / "c")
+    assert rc in (0, 3), out + err
+    assert "w0 = 1 rad/s, continuous-time model" in out.splitlines()[0]
+    rc, out, err = identify_cli(capsys, *files, *argv, "--discrete", "--out", tmp_path / "d")
+    assert rc in (0, 3), out + err
+    summary = json.loads((tmp_path / "d" / "summary.json").read_text())
+    assert summary["ts"] == pytest.approx(T0 / N, rel=1e-12) and summary["w0"] == pytest.approx(W0, rel=1e-12)
+    model = lptv.MimoModel.load(tmp_path / "d" / "model.json")
+    res = lptv.identify(experiments, na=2, nb=2, ka=[1, 0, 0], w0=W0, ts=T0 / N)
+    assert model.discrete and np.allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
+
+
 def test_without_the_mimo_fit_the_command_says_so(files, tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(mimoid, "mimo_fit_available", lambda: False)
     rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")

@@ -17,6 +17,7 @@ Example::
 """
 from __future__ import annotations
 
+import dataclasses
 import re
 import sys
 import warnings
@@ -104,8 +105,8 @@ def read_experiments(args):
                     raise FileError("--discrete needs the sampling frequency --fs (or --dt)")
                 ts = 1.0 / meas.fs
             saved, args.ts = args.ts, ts
-            try:
-                w0s.append(fundamental(args, meas))
+            try:      # the samples per period are read from a channel's (P, N) periods
+                w0s.append(fundamental(args, dataclasses.replace(meas, u=meas.u[..., 0], y=meas.y[..., 0])))
             finally:
                 args.ts = saved
         except (FileError, ValueError) as e:
