@@ -173,6 +173,14 @@ def test_npz_periods_with_a_stored_fs_and_a_discrete_time_model(experiments, tmp
     assert model.discrete and np.allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
 
 
+@needs_fit
+def test_the_fit_s_refusals_name_the_options(files, tmp_path, capsys):
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--lines", "1-20", "--out", tmp_path / "o")
+    assert rc == 2 and err.startswith("lptv identify: error: --lines: line 1 (") and "outside" in err
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--method", "ls", "--out", tmp_path / "o")
+    assert rc == 2 and "--method" in err and len(err.strip().splitlines()) == 1
+
+
 def test_without_the_mimo_fit_the_command_says_so(files, tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(mimoid, "mimo_fit_available", lambda: False)
     rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")

@@ -27,8 +27,8 @@ import numpy as np
 
 import lptv
 from lptv import NumericalError
-from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, fundamental, integer, output_folder, parse_counts,
-                               parse_lines, positive, read_options)
+from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fundamental, in_option_terms, integer,
+                               output_folder, parse_counts, parse_lines, positive, read_options)
 from lptv.apps.report import write_fit
 from lptv.measurements import FileError, read_measurements
 
@@ -141,9 +141,9 @@ def run(args) -> int:
             res = lptv.identify(experiments, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                                 lines=lines, method=args.method, tol=args.tol, max_iter=args.max_iter)
     except NumericalError as e:
-        return _fail(_named(e, files), status=1)
+        return _fail(in_option_terms(_named(e, files), OPTION_NAMES), status=1)
     except ValueError as e:
-        return _fail(_named(e, files))
+        return _fail(in_option_terms(_named(e, files), OPTION_NAMES))
     notes = [str(w.message) for w in caught if str(w.message) not in getattr(res, "warnings", ())]
 
     out = Path(args.out) if args.out else Path(Path(files[0]).stem + "-lptv")
