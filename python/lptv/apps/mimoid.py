@@ -73,7 +73,7 @@ def _check_options(args):
             opt = "--" + key.replace("_", "-")
             raise FileError(f"{opt} is for one input and one output; several channels take the files, "
                             "--input, --output, the structure, --lines, --method, --max-iter, --tol and --out")
-    if getattr(args, "noise", "sample") != "sample":
+    if getattr(args, "noise", None) == "moderated":     # the fit of several channels weighs by the sample's
         raise FileError("--noise moderated is for one input and one output")
     if getattr(args, "referred", "auto") not in ("auto",):
         raise FileError("--referred is for records of realisations of one input and one output")
