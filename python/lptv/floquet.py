@@ -215,8 +215,8 @@ def stability_check(model) -> Tuple[Optional[str], Optional[str]]:
     error (else None), and a sentence when the check could not decide within its cost bound
     (else None); at most one of the two is set.
 
-    LTI models: the roots of a(s) (a(z)). A :class:`lptv.MimoModel`: :func:`floquet` with Hill's
-    matrix at most ``CHECK_MAX_HILL`` rows (discrete time: the exact product). LPTV models: the monodromy matrix by products
+    LTI models: the roots of a(s) (a(z)). A :class:`lptv.MimoModel`: the products below on its
+    state form (:func:`monodromy`), then :func:`floquet` as below. LPTV models: the monodromy matrix by products
     (:func:`monodromy` with 32, 64, ... up to ``CHECK_MAX_STEPS`` steps, until two successive
     spectral radii differ by less than a tenth of their distance to 1: under a millisecond on
     the paper's model), then :func:`floquet` with Hill's matrix at most ``CHECK_MAX_HILL`` rows.
@@ -260,8 +260,26 @@ def stability_check(model) -> Tuple[Optional[str], Optional[str]]:
 
 
 def _mimo_stability(model: MimoModel) -> Tuple[Optional[str], Optional[str]]:
-    # Hill's method (or the exact product in discrete time) with its matrix at most
-    # CHECK_MAX_HILL rows: the state has sum_p d_p components.
+    # As for one output: the products first (the monodromy of the observer form with 32, 64, ...
+    # CHECK_MAX_STEPS Magnus steps until two spectral radii differ by less than a tenth of their
+    # distance to 1; discrete time the one exact product), then Hill's method with its matrix at
+    # most CHECK_MAX_HILL rows (the state has sum_p d_p components).
+    prev = None
+    for steps in ([0] if model.discrete else [32 * 2 ** i for i in range(int(np.log2(CHECK_MAX_STEPS // 32)) + 1)]):
+        try:
+            Phi = np.asarray(_core.monodromy_mimo(model._cpp, steps))
+        except _core.NumericalError:
+            prev = None
+            continue
+        rho = float(np.abs(np.linalg.eigvals(Phi)).max()) if Phi.size else 0.0
+        if not np.isfinite(rho):
+            prev = None
+            continue
+        if (model.discrete and rho != 1.0) or (prev is not None and abs(rho - prev) < 0.1 * abs(rho - 1.0)):
+            if rho > 1.0:
+                return f"the model is unstable (Floquet multiplier of magnitude {rho:.6g} > 1)", None
+            return None, None
+        prev = rho
     n = int(sum(_core.mimo_row_degrees(model._cpp)))
     try:
         f = floquet(model, max_truncation=max(1, (CHECK_MAX_HILL // max(n, 1) - 1) // 2))
