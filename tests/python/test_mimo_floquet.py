@@ -181,6 +181,19 @@ def test_simulate_warns_for_an_unstable_matrix_model():
             assert "Floquet multiplier of magnitude 1.0272" in str(found[0].message)
 
 
+def test_an_undamped_system_is_marginal_neither_stable_nor_reported_unstable():
+    """C = 0, K constant: every multiplier on the unit circle. The products' radii sit at 1 and
+    never settle, Hill's method decides: not stable (marginal), and simulate's check reports
+    nothing (neither unstable nor undecided)."""
+    from lptv.floquet import stability_check
+
+    model = lptv.MimoModel.mechanical(np.diag([1.0, 2.0]), np.zeros((2, 2)), [[7.0, -2.0], [-2.0, 5.0]],
+                                      np.eye(2), w0=1.0)
+    f = lptv.floquet(model)
+    assert not f.is_stable and np.all(np.abs(np.abs(f.multipliers) - 1) <= 1e-9)
+    assert stability_check(model) == (None, None)
+
+
 def mixed_degrees(seed, w0=1.0, ts=None, **means):
     """Row 1: y1'' + al(t) y2'' + c y1' + k(t) y1 + g(t) y2 = 0; row 2: y2' + f(t) y1' + e(t) y2
     + h(t) y1 = 0 (row degrees 2 and 1, A_2 = [[1, al], [0, 0]] singular, L = [[1, al], [f, 1]]);
