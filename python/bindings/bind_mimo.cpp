@@ -1,4 +1,5 @@
 #include "lptv/mimo.hpp"
+#include "lptv/mimo_estimators.hpp"
 #include "pybind11.hpp"
 
 namespace {
@@ -39,6 +40,68 @@ Eigen::SparseMatrix<std::complex<double>> mimo_band_py(const lptv::MimoModel& mo
   return a ? lptv::build_mimo_A(model, g) : lptv::build_mimo_B(model, g);
 }
 
+using SpectraTuple = std::tuple<Eigen::MatrixXcd, Eigen::MatrixXcd, Eigen::MatrixXcd, std::vector<int>>;
+
+std::vector<lptv::MimoSpectra> spectra_of(const std::vector<SpectraTuple>& data) {
+  std::vector<lptv::MimoSpectra> out;
+  for (const auto& t : data) {
+    lptv::MimoSpectra d;
+    d.Y = std::get<0>(t);
+    d.U = std::get<1>(t);
+    d.C = std::get<2>(t);
+    d.rows = std::get<3>(t);
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+lptv::MimoEstimate wgtls_py(const std::vector<SpectraTuple>& data, const lptv::MimoStructure& s, double tol,
+                            int max_iter, bool weighted) {
+  const auto d = spectra_of(data);
+  py::gil_scoped_release release;  // pure C++ work on copies
+  return lptv::mimo_wgtls(d, s, tol, max_iter, weighted);
+}
+
+lptv::MimoEstimate sml_py(const std::vector<SpectraTuple>& data, const lptv::MimoStructure& s,
+                          const Eigen::VectorXd& xi0, double tol, int max_iter) {
+  const auto d = spectra_of(data);
+  py::gil_scoped_release release;  // pure C++ work on copies
+  return lptv::mimo_sml(d, s, xi0, tol, max_iter);
+}
+
+Eigen::MatrixXd fisher_py(const std::vector<SpectraTuple>& data, const lptv::MimoStructure& s,
+                          const Eigen::VectorXd& xi) {
+  const auto d = spectra_of(data);
+  py::gil_scoped_release release;  // pure C++ work on copies
+  return lptv::mimo_fisher(d, s, xi);
+}
+
+Eigen::MatrixXd sandwich_py(const std::vector<SpectraTuple>& data, const lptv::MimoStructure& s,
+                            const Eigen::VectorXd& xi) {
+  const auto d = spectra_of(data);
+  py::gil_scoped_release release;  // pure C++ work on copies
+  return lptv::mimo_sandwich(d, s, xi);
+}
+
+py::tuple residues_py(const SpectraTuple& data, const lptv::MimoStructure& s, const Eigen::VectorXd& xi) {
+  const auto d = spectra_of({data});
+  Eigen::MatrixXcd e, Ce;
+  lptv::mimo_residues(d[0], s, xi, e, Ce);
+  return py::make_tuple(e, Ce);
+}
+
+lptv::MimoStructure make_structure(int ny, int nu, const Eigen::MatrixXi& ka, const Eigen::MatrixXi& kb, double w0,
+                                   double ts) {
+  lptv::MimoStructure s;
+  s.ny = ny;
+  s.nu = nu;
+  s.ka = ka;
+  s.kb = kb;
+  s.w0 = w0;
+  s.ts = ts;
+  return s;
+}
+
 }  // namespace
 
 void bind_mimo(py::module_& m) {
@@ -63,4 +126,27 @@ void bind_mimo(py::module_& m) {
         "guard"_a = -1, "tol"_a = 1e-13, "max_guard"_a = -1);
   m.def("mimo_htf", &mimo_htf_py, "model"_a, "L"_a, "lines"_a, "solver"_a = "auto");
   m.def("mimo_band_matrix", &mimo_band_py, "model"_a, "L"_a, "a"_a = true);
+
+  py::class_<lptv::MimoStructure>(m, "MimoStructure",
+                                  "Row-uniform structure of a MIMO fit: ka (na+1) x ny, kb (nb+1) x nu.")
+      .def(py::init(&make_structure), "ny"_a, "nu"_a, "ka"_a, "kb"_a, "w0"_a, "ts"_a = 0.0)
+      .def_readonly("ny", &lptv::MimoStructure::ny)
+      .def_readonly("nu", &lptv::MimoStructure::nu);
+  py::class_<lptv::MimoEstimate>(m, "MimoEstimate", "A MIMO WGTLS or SML estimate (see lptv.mimo_fit).")
+      .def_readonly("xi", &lptv::MimoEstimate::xi)
+      .def_readonly("singular_values", &lptv::MimoEstimate::singular_values)
+      .def_readonly("information", &lptv::MimoEstimate::information)
+      .def_readonly("cost", &lptv::MimoEstimate::cost)
+      .def_readonly("iterations", &lptv::MimoEstimate::iterations)
+      .def_readonly("converged", &lptv::MimoEstimate::converged)
+      .def_readonly("noise_free", &lptv::MimoEstimate::noise_free);
+  m.def("mimo_wgtls", &wgtls_py, "data"_a, "structure"_a, "tol"_a, "max_iter"_a, "weighted"_a = true,
+        "WGTLS with vector residues and A_na,0 = I; data: list of (Y, U, C, rows), C of shape ((L+1)(ny+nu), ny+nu)");
+  m.def("mimo_sml", &sml_py, "data"_a, "structure"_a, "xi0"_a, "tol"_a, "max_iter"_a,
+        "Levenberg-Marquardt on the rows' exact likelihood from xi0");
+  m.def("mimo_fisher", &fisher_py, "data"_a, "structure"_a, "xi"_a, "Fisher information over the free entries");
+  m.def("mimo_sandwich", &sandwich_py, "data"_a, "structure"_a, "xi"_a, "WGTLS's first-order sandwich covariance");
+  m.def("mimo_residues", &residues_py, "data"_a, "structure"_a, "xi"_a,
+        "(residues rows x ny, their covariances (rows ny) x ny) of one experiment");
+  m.def("mimo_free_indices", &lptv::mimo_free_indices, "structure"_a);
 }

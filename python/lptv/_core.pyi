@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoModel', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_htf', 'mimo_row_degrees', 'mimo_state_matrix', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_sandwich', 'mimo_sml', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -630,6 +630,43 @@ class MimoModel:
     @property
     def w0(self) -> float:
         ...
+class MimoStructure:
+    """
+    Row-uniform structure of a MIMO fit: ka (na+1) x ny, kb (nb+1) x nu.
+    """
+    def __init__(self, ny: typing.SupportsInt | typing.SupportsIndex, nu: typing.SupportsInt | typing.SupportsIndex, ka: typing.Annotated[numpy.typing.ArrayLike, numpy.int32, "[m, n]"], kb: typing.Annotated[numpy.typing.ArrayLike, numpy.int32, "[m, n]"], w0: typing.SupportsFloat | typing.SupportsIndex, ts: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
+        ...
+    @property
+    def nu(self) -> int:
+        ...
+    @property
+    def ny(self) -> int:
+        ...
+class MimoEstimate:
+    """
+    A MIMO WGTLS or SML estimate (see lptv.mimo_fit).
+    """
+    @property
+    def converged(self) -> bool:
+        ...
+    @property
+    def cost(self) -> float:
+        ...
+    @property
+    def information(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def iterations(self) -> int:
+        ...
+    @property
+    def noise_free(self) -> bool:
+        ...
+    @property
+    def singular_values(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def xi(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 def band_matrix(model: Model, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
 def column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -727,10 +764,6 @@ def floquet(model: Model, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-
     """
     Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).
     """
-def floquet_mimo(model: ..., tol: typing.SupportsFloat | typing.SupportsIndex = 1e-11, min_truncation: typing.SupportsInt | typing.SupportsIndex = 8, max_truncation: typing.SupportsInt | typing.SupportsIndex = 256) -> Floquet:
-    """
-    Multipliers and exponents of the matrix system (see lptv.floquet for the documented API).
-    """
 def gsvd_pairs(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], int]:
     ...
 def htf(model: Model, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -756,15 +789,29 @@ def lp_norm_log(lines: collections.abc.Sequence[typing.SupportsInt | typing.Supp
     ...
 def mimo_band_matrix(model: MimoModel, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
+def mimo_fisher(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    Fisher information over the free entries
+    """
+def mimo_free_indices(structure: MimoStructure) -> list[int]:
+    ...
 def mimo_htf(model: MimoModel, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
-def mimo_row_degrees(model: ...) -> list[int]:
+def mimo_residues(data: tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple:
     """
-    The row degrees d_p of A(t, s).
+    (residues rows x ny, their covariances (rows ny) x ny) of one experiment
     """
-def mimo_state_matrix(model: ..., t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+def mimo_sandwich(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     """
-    The state (one-step) matrix of the matrix system's observer form at time t.
+    WGTLS's first-order sandwich covariance
+    """
+def mimo_sml(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex) -> MimoEstimate:
+    """
+    Levenberg-Marquardt on the rows' exact likelihood from xi0
+    """
+def mimo_wgtls(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex, weighted: bool = True) -> MimoEstimate:
+    """
+    WGTLS with vector residues and A_na,0 = I; data: list of (Y, U, C, rows), C of shape ((L+1)(ny+nu), ny+nu)
     """
 def minimize_crest_factor(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex, oversample: typing.SupportsInt | typing.SupportsIndex = 0, max_p: typing.SupportsInt | typing.SupportsIndex = 1024, iterations_per_p: typing.SupportsInt | typing.SupportsIndex = 100) -> CrestResult:
     ...
@@ -787,11 +834,6 @@ def monodromy(model: Model, steps: typing.SupportsInt | typing.SupportsIndex) ->
     """
     Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps
     and Richardson) or of the one-step companion matrices (discrete time).
-    """
-def monodromy_mimo(model: ..., steps: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-    """
-    Monodromy matrix of the matrix system's state form by products (Magnus steps and Richardson, or the
-    one-step matrices in discrete time).
     """
 def multisine_spectrum(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     ...

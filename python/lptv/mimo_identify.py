@@ -12,7 +12,7 @@ import numpy as np
 from ._validate import _array, as_float, as_int, as_lines, check_finite
 from .mimo import MimoModel
 from .mimo_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
-from .mimo_fit import FitError, expand, fisher, prepare, sandwich, sml, wgtls, line_covariance
+from .mimo_fit import FitError, core_data, core_structure, expand, fisher, residues, sandwich, sml, wgtls
 from .mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
@@ -131,10 +131,10 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     if n_eq < st.free.size:
         raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters")
     P = np.array([d.periods for d in datas])
-    exps = prepare(datas, st, rows_list)
+    data, cst = core_data(datas, rows_list), core_structure(st)
     warns = []
     try:
-        xi, iters, converged, sv, noise_free = wgtls(exps, st, tol=tol, max_iter=max_iter,
+        xi, iters, converged, sv, noise_free = wgtls(data, cst, tol=tol, max_iter=max_iter,
                                                      method="gtls" if method == "gtls" else "wgtls")
         d = ny * ny
         if sv.size > d and sv[d] < 1.5 * sv[d - 1]:
@@ -144,19 +144,17 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         cost_sml = None
         F = None
         if method == "sml" and not noise_free:
-            xi, cost_sml, F, iters, converged = sml(exps, st, xi, tol=tol, max_iter=max_iter)
+            xi, cost_sml, F, iters, converged = sml(data, cst, xi, tol=tol, max_iter=max_iter)
+        res, Ce = residues(data, cst, xi)
     except FitError as err:
         raise ValueError(f"u, y: {err}") from None
-    Th = st.theta(xi)
-    res = np.vstack([ex.Phi @ Th for ex in exps])
-    Ce = np.concatenate([line_covariance(ex.Cphi, Th) for ex in exps])
     n_scalar = res.size
     if cost_sml is not None:
         cost = cost_sml / n_scalar
+    elif noise_free:
+        cost = 0.0
     else:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            q = np.real(np.einsum("rp,rp->r", res.conj(), np.linalg.solve(Ce, res[..., None])[..., 0])) \
-                if not noise_free else np.zeros(res.shape[0])
+        q = np.real(np.einsum("rp,rp->r", res.conj(), np.linalg.solve(Ce, res[..., None])[..., 0]))
         cost = float(np.sum(q)) / n_scalar
     cov, factor = None, 1.0
     if covariance == "analytic" and not noise_free:
@@ -169,8 +167,8 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
             warns.append(f"the covariance is without its small-sample factor (P - 1) / (P - 3): P = {Pmin} "
                          "periods, at least 4 needed")
         try:
-            free_cov = np.linalg.inv(F if F is not None else fisher(exps, st, xi)) if method == "sml" \
-                else sandwich(exps, st, xi)
+            free_cov = np.linalg.inv(F if F is not None else fisher(data, cst, xi)) if method == "sml" \
+                else sandwich(data, cst, xi)
         except (np.linalg.LinAlgError, FitError) as err:
             raise ValueError(f"u, y: the covariance cannot be formed: {err}") from None
         cov = factor * expand(free_cov, st)
@@ -281,6 +279,5 @@ def mimo_crb(model: MimoModel, inputs, *, noise, periods: int, lines=None, ka=No
         d = MimoFrequencyData(U=U[e], Y=Y, C=np.array(C) / periods, periods=periods, w0=model.w0, ts=model.ts)
         datas.append(d)
         rows_list.append(_rows_of(d, lines, st.K, e))
-    exps = prepare(datas, st, rows_list)
-    F = fisher(exps, st, xi)
+    F = fisher(core_data(datas, rows_list), core_structure(st), xi)
     return MimoCramerRaoBound(covariance=expand(np.linalg.inv(F), st), eta=xi, parameter_names=st.names)

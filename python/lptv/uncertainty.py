@@ -10,6 +10,7 @@ from . import _core
 from ._validate import _array, as_int, as_spectrum
 from .fds import simulate
 from .identify import _counts, _known_list, _rows
+from .mimo import MimoModel
 from .model import Model
 from .multisine import Multisine
 
@@ -70,8 +71,11 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
 
     Parameters
     ----------
-    model : lptv.Model
-        The true system.
+    model : lptv.Model or lptv.MimoModel
+        The true system. A :class:`MimoModel` hands over to :func:`lptv.mimo_crb` with ``u``
+        its input spectra (E, L+1, nu) and ``var_y`` (ny,), ``var_u`` (nu,) one period's noise
+        variance per channel (a scalar for all); the result is then a
+        :class:`lptv.MimoCramerRaoBound` (``known`` and ``cov_yu`` are not built for it).
     u : Multisine or array_like
         The excitation: a :class:`Multisine` or its one-sided spectrum on lines 0..L
         (``fft(u)[l] / N``).
@@ -104,8 +108,10 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
     >>> bool(b.std[0] < 1e-2)
     True
     """
+    if isinstance(model, MimoModel):
+        return _crb_mimo(model, u, var_y, var_u, cov_yu, periods, lines, ka, kb, known)
     if not isinstance(model, Model):
-        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+        raise ValueError(f"model must be an lptv.Model or lptv.MimoModel, got {type(model).__name__}")
     if isinstance(u, (list, tuple)) and len(u) > 0 and all(
             isinstance(x, Multisine) or np.ndim(x) == 1 for x in u):
         return _crb_experiments(model, list(u), var_y=var_y, var_u=var_u, cov_yu=cov_yu, periods=periods,
@@ -114,6 +120,20 @@ def crb(model: Model, u, *, var_y, var_u=0.0, cov_yu=0.0, periods: int = 1, line
     cov = np.asarray(_core.cramer_rao_bound(data, par, rows, theta))
     return CramerRaoBound(covariance=cov, eta=xi[:par.n_eta], eta_names=tuple(par.eta_names),
                           lines=np.asarray(rows), periods=periods)
+
+
+def _crb_mimo(model, u, var_y, var_u, cov_yu, periods, lines, ka, kb, known):
+    """crb of a MimoModel: :func:`lptv.mimo_crb` with var_y (ny,) and var_u (nu,) per channel."""
+    from .mimo_identify import mimo_crb
+
+    if known:
+        raise ValueError("known: not built yet for several inputs or outputs (the normalisation is A_na,0 = I)")
+    if np.any(np.asarray(cov_yu) != 0):
+        raise ValueError("cov_yu: correlated input and output noise is given to lptv.mimo_crb as a full "
+                         "noise covariance per line (noise=(L+1, ny+nu, ny+nu)) for several channels")
+    vy = np.broadcast_to(np.asarray(_array(var_y, "var_y"), dtype=float), (model.n_outputs,))
+    vu = np.broadcast_to(np.asarray(_array(var_u, "var_u"), dtype=float), (model.n_inputs,))
+    return mimo_crb(model, u, noise=np.r_[vy, vu], periods=periods, lines=lines, ka=ka, kb=kb)
 
 
 def _design(model, u, var_y, var_u, cov_yu, periods, lines, ka, kb, known, check_count=True):

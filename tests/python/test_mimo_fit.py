@@ -92,13 +92,13 @@ def test_sml_and_covariances_match_reference(system, seed):
     cov_ref = np.linalg.inv(ref.fisher(st, res.eta, data))
     cov = res.covariance[np.ix_(free, free)] / res.covariance_factor
     assert np.allclose(cov, cov_ref, rtol=1e-8, atol=1e-10 * np.abs(cov_ref).max())
-    from lptv.mimo_fit import prepare, sandwich
+    from lptv.mimo_fit import core_data, core_structure, sandwich
     from lptv.mimo_data import MimoStructure
     datas = [MimoFrequencyData.from_periods(u, y, w0=mx.W0) for u, y in pairs]
     ny, nu = model.n_outputs, model.n_inputs
     s = STRUCTURE[system]
     mst = MimoStructure(s["na"], s["nb"], st.ka, st.kb, ny, nu, mx.W0)
-    sw = sandwich(prepare(datas, mst, [r for *_, r in data]), mst, res.eta)
+    sw = sandwich(core_data(datas, [r for *_, r in data]), core_structure(mst), res.eta)
     sw_ref = ref.sandwich(st, res.eta, data)
     assert np.allclose(sw, sw_ref, rtol=1e-8, atol=1e-10 * np.abs(sw_ref).max())
 
@@ -238,3 +238,13 @@ def test_docstring_examples_run():
     for mod in (lptv.mimo_data, lptv.mimo_examples, lptv.mimo_identify, lptv.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
+
+
+def test_crb_of_a_mimo_model_is_mimo_crb():
+    model = mx.SYSTEMS["2-in-1-out"]()[0]
+    d = lptv.mimo_multisines(LINES, N, 2, seed=1)
+    a = lptv.crb(model, d.spectra, var_y=1e-4, var_u=[1e-5, 2e-5], periods=8, ka=[1, 0, 0], kb=[1, 0])
+    b = lptv.mimo_crb(model, d.spectra, noise=[1e-4, 1e-5, 2e-5], periods=8, ka=[1, 0, 0], kb=[1, 0])
+    assert np.array_equal(a.covariance, b.covariance)
+    with pytest.raises(ValueError, match="^cov_yu"):
+        lptv.crb(model, d.spectra, var_y=1e-4, cov_yu=1e-6, periods=8)

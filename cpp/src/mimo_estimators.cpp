@@ -1,0 +1,631 @@
+// METHOD.md section 19: WGTLS and SML with vector residues. The route is that of
+// python/lptv/reference/mimo_fit.py's equations, computed per row: regressors phi_l shared by
+// every output's equation (row-uniform structure), their noise Cphi_l (entries of one harmonic
+// read one line), the per-line residue covariance C_{e,l} = Theta^T conj(Cphi_l) conj(Theta),
+// and for SML the rows' full covariance C_E (a Hermitian band of half bandwidth (2K+1) ny - 1)
+// factored by a band Cholesky.
+#include "lptv/mimo_estimators.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "lptv/errors.hpp"
+
+namespace lptv {
+namespace {
+
+using cd = std::complex<double>;
+using Eigen::MatrixXcd;
+using Eigen::MatrixXd;
+using Eigen::VectorXcd;
+using Eigen::VectorXd;
+
+constexpr double kVarianceFloor = 1e-14;  // as the single-output weights' floor
+
+struct Params {
+  int ny = 1, nu = 1, na = 0, nphi = 0, nrow = 0, K = 0;
+  std::vector<int> is_a, order, col, k, channel;
+  MatrixXcd T;
+  std::vector<std::vector<std::pair<int, cd>>> tcols;  // T's nonzeros per column (one or two)
+  std::vector<int> fixed_row;
+  double w0 = 1.0, ts = 0.0;
+  int nxi() const { return ny * nrow; }
+  int nc() const { return ny + nu; }
+  cd s(int i) const { return ts > 0 ? std::exp(cd(0.0, w0 * i * ts)) : cd(0.0, w0 * i); }
+};
+
+cd ipow(cd x, int n) {
+  cd r(1.0, 0.0);
+  for (int j = 0; j < n; ++j) r *= x;
+  return r;
+}
+
+Params make_params(const MimoStructure& st) {
+  if (st.ny < 1 || st.nu < 1) throw std::invalid_argument("structure: ny and nu must be positive");
+  if (st.ka.rows() < 1 || st.ka.cols() != st.ny || st.kb.rows() < 1 || st.kb.cols() != st.nu)
+    throw std::invalid_argument("structure: ka must be (na+1) x ny and kb (nb+1) x nu");
+  if (st.ka.minCoeff() < 0 || st.kb.minCoeff() < 0)
+    throw std::invalid_argument("structure: harmonic counts must be non-negative");
+  if (!(st.w0 > 0) || !std::isfinite(st.w0) || !(st.ts >= 0) || !std::isfinite(st.ts))
+    throw std::invalid_argument("structure: w0 must be positive and ts non-negative");
+  Params p;
+  p.ny = st.ny;
+  p.nu = st.nu;
+  p.na = static_cast<int>(st.ka.rows()) - 1;
+  p.w0 = st.w0;
+  p.ts = st.ts;
+  p.K = std::max(st.ka.maxCoeff(), st.kb.maxCoeff());
+  std::vector<std::vector<std::pair<int, cd>>> cols;
+  auto add = [&](bool a, int n, int c, int K) {
+    const int base = static_cast<int>(p.is_a.size());
+    for (int k = -K; k <= K; ++k) {
+      p.is_a.push_back(a);
+      p.order.push_back(n);
+      p.col.push_back(c);
+      p.k.push_back(k);
+      p.channel.push_back(a ? c : p.ny + c);
+    }
+    if (a && n == p.na) p.fixed_row.push_back(static_cast<int>(cols.size()));
+    cols.push_back({{base + K, cd(1, 0)}});
+    for (int k = 1; k <= K; ++k) {
+      cols.push_back({{base + K + k, cd(1, 0)}, {base + K - k, cd(1, 0)}});
+      cols.push_back({{base + K + k, cd(0, 1)}, {base + K - k, cd(0, -1)}});
+    }
+  };
+  for (int n = 0; n <= p.na; ++n)
+    for (int q = 0; q < p.ny; ++q) add(true, n, q, st.ka(n, q));
+  for (int m = 0; m < st.kb.rows(); ++m)
+    for (int r = 0; r < p.nu; ++r) add(false, m, r, st.kb(m, r));
+  p.nphi = static_cast<int>(p.is_a.size());
+  p.nrow = static_cast<int>(cols.size());
+  p.T = MatrixXcd::Zero(p.nphi, p.nrow);
+  for (int j = 0; j < p.nrow; ++j)
+    for (const auto& e : cols[j]) p.T(e.first, j) = e.second;
+  p.tcols = cols;
+  return p;
+}
+
+MatrixXcd theta_of(const Params& p, const VectorXd& xi) {
+  const Eigen::Map<const MatrixXd> X(xi.data(), p.nrow, p.ny);
+  return p.T * X.cast<cd>();
+}
+
+struct Prep {
+  const MimoSpectra* d = nullptr;
+  MatrixXcd Phi, Psi;
+  std::vector<MatrixXcd> Cphi, Cpsi;
+  int R() const { return static_cast<int>(d->rows.size()); }
+};
+
+MatrixXcd regressors(const Params& p, const std::vector<int>& rows, const MatrixXcd& Y, const MatrixXcd& U) {
+  MatrixXcd Phi(rows.size(), p.nphi);
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (int j = 0; j < p.nphi; ++j) {
+      const int i = rows[r] - p.k[j];
+      const cd x = p.is_a[j] ? Y(i, p.col[j]) : -U(i, p.col[j]);
+      Phi(r, j) = ipow(p.s(i), p.order[j]) * x;
+    }
+  return Phi;
+}
+
+void check(const std::vector<MimoSpectra>& data, const Params& p) {
+  if (data.empty()) throw std::invalid_argument("data: no experiment");
+  for (size_t e = 0; e < data.size(); ++e) {
+    const MimoSpectra& d = data[e];
+    const std::string where = "data[" + std::to_string(e) + "]";
+    const Eigen::Index L1 = d.Y.rows();
+    if (d.Y.cols() != p.ny || d.U.cols() != p.nu || d.U.rows() != L1 || d.C.rows() != L1 * p.nc() ||
+        d.C.cols() != p.nc())
+      throw std::invalid_argument(where + ": Y must be (L+1) x ny, U (L+1) x nu, C (L+1)(ny+nu) x (ny+nu)");
+    if (!d.Y.allFinite() || !d.U.allFinite() || !d.C.allFinite())
+      throw std::invalid_argument(where + ": the spectra or covariances contain NaN or inf");
+    if (d.rows.empty()) throw std::invalid_argument(where + ".rows: no row");
+    for (size_t r = 0; r < d.rows.size(); ++r) {
+      if (d.rows[r] - p.K < 1 || d.rows[r] + p.K > L1 - 1)
+        throw std::invalid_argument(where + ".rows: line " + std::to_string(d.rows[r]) +
+                                    " reads lines outside 1..L (K = " + std::to_string(p.K) + ")");
+      if (r > 0 && d.rows[r] <= d.rows[r - 1]) throw std::invalid_argument(where + ".rows: must increase");
+    }
+  }
+}
+
+Prep prepare(const MimoSpectra& d, const Params& p) {
+  Prep x;
+  x.d = &d;
+  x.Phi = regressors(p, d.rows, d.Y, d.U);
+  x.Psi = x.Phi * p.T;
+  const int R = x.R(), c = p.nc();
+  x.Cphi.assign(R, MatrixXcd::Zero(p.nphi, p.nphi));
+  x.Cpsi.resize(R);
+  std::vector<cd> f(p.nphi);
+  for (int r = 0; r < R; ++r) {
+    for (int j = 0; j < p.nphi; ++j)
+      f[j] = (p.is_a[j] ? 1.0 : -1.0) * ipow(p.s(d.rows[r] - p.k[j]), p.order[j]);
+    for (int a = 0; a < p.nphi; ++a)
+      for (int b = 0; b < p.nphi; ++b) {
+        if (p.k[a] != p.k[b]) continue;
+        const int i = d.rows[r] - p.k[a];
+        x.Cphi[r](a, b) = std::conj(f[a]) * f[b] * d.C(i * c + p.channel[b], p.channel[a]);
+      }
+    // T^H Cphi T through T's one or two nonzeros per column
+    MatrixXcd& Cp = x.Cpsi[r];
+    Cp.resize(p.nrow, p.nrow);
+    for (int i = 0; i < p.nrow; ++i)
+      for (int j = 0; j < p.nrow; ++j) {
+        cd v(0.0, 0.0);
+        for (const auto& a : p.tcols[i])
+          for (const auto& b : p.tcols[j]) v += std::conj(a.second) * x.Cphi[r](a.first, b.first) * b.second;
+        Cp(i, j) = v;
+      }
+  }
+  return x;
+}
+
+std::vector<MatrixXcd> line_covariances(const Prep& x, const MatrixXcd& Th) {
+  std::vector<MatrixXcd> out(x.R());
+  for (int r = 0; r < x.R(); ++r) out[r] = Th.transpose() * x.Cphi[r].conjugate() * Th.conjugate();
+  return out;
+}
+
+std::vector<MatrixXcd> weights(const std::vector<MatrixXcd>& Ce) {
+  std::vector<Eigen::SelfAdjointEigenSolver<MatrixXcd>> es;
+  double top = 0.0;
+  for (const auto& c : Ce) {
+    es.emplace_back(c);
+    top = std::max(top, es.back().eigenvalues().maxCoeff());
+  }
+  if (!(top > 0) || !std::isfinite(top))
+    throw NumericalError("the residue covariance is not positive: the data carry no noise on the rows");
+  std::vector<MatrixXcd> W(Ce.size());
+  for (size_t r = 0; r < Ce.size(); ++r) {
+    const VectorXd lam = es[r].eigenvalues().cwiseMax(kVarianceFloor * top);
+    const MatrixXcd& V = es[r].eigenvectors();
+    W[r] = V * lam.cwiseInverse().asDiagonal() * V.adjoint();
+  }
+  return W;
+}
+
+// The whitened real rows [Re; Im] of one experiment (appended to J) and its CJ_W (added to CJ).
+void whitened(const Prep& x, const Params& p, const std::vector<MatrixXcd>* W, MatrixXd& J, Eigen::Index& at,
+              MatrixXd& CJ) {
+  const int R = x.R(), ny = p.ny, nr = p.nrow;
+  const Eigen::Index half = J.rows() / 2;
+  for (int r = 0; r < R; ++r) {
+    MatrixXcd M = MatrixXcd::Identity(ny, ny);
+    if (W) {
+      Eigen::LLT<MatrixXcd> llt((*W)[r]);
+      M = llt.matrixL().adjoint();  // M^H M = W: M e is the whitened residue
+    }
+    for (int q = 0; q < ny; ++q) {
+      for (int pp = 0; pp < ny; ++pp) {
+        const cd m = M(q, pp);
+        for (int i = 0; i < nr; ++i) {
+          const cd v = m * x.Psi(r, i);
+          J(at, pp * nr + i) = v.real();
+          J(half + at, pp * nr + i) = v.imag();
+        }
+      }
+      ++at;
+    }
+    for (int pp = 0; pp < ny; ++pp)
+      for (int qq = 0; qq < ny; ++qq) {
+        const cd w = W ? (*W)[r](pp, qq) : cd(pp == qq ? 1.0 : 0.0, 0.0);
+        if (w == cd(0, 0)) continue;
+        CJ.block(pp * nr, qq * nr, nr, nr) += w.real() * x.Cpsi[r].real() - w.imag() * x.Cpsi[r].imag();
+      }
+  }
+}
+
+VectorXd normalise(const MatrixXd& V, const Params& p) {
+  const int ny = p.ny, d = ny * ny;
+  MatrixXd Nm(d, V.cols());
+  VectorXd c = VectorXd::Zero(d);
+  for (int pp = 0; pp < ny; ++pp)
+    for (int q = 0; q < ny; ++q) {
+      Nm.row(pp * ny + q) = V.row(pp * p.nrow + p.fixed_row[q]);
+      c(pp * ny + q) = pp == q ? 1.0 : 0.0;
+    }
+  Eigen::FullPivLU<MatrixXd> lu(Nm);
+  if (!lu.isInvertible())
+    throw NumericalError("the normalisation A_na,0 = I cannot be applied: the leading matrix's mean is singular "
+                         "in the subspace of the smallest singular values");
+  return V * lu.solve(c);
+}
+
+// The d right generalised singular vectors of (Jx, CJ^{1/2}) of the smallest values and all
+// values ascending; CJ null: TLS.
+void subspace(const MatrixXd& Jx, const MatrixXd* CJ, int d, MatrixXd& V, VectorXd& values) {
+  const Eigen::Index n = Jx.cols();
+  VectorXd sc(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double nrm = Jx.col(j).norm();
+    sc(j) = nrm > 0 ? 1.0 / nrm : 1.0;
+  }
+  const MatrixXd A = Jx * sc.asDiagonal();
+  MatrixXd R;
+  if (A.rows() > n) {
+    Eigen::HouseholderQR<MatrixXd> qr(A);
+    R = qr.matrixQR().topRows(n).triangularView<Eigen::Upper>();
+  } else {
+    R = A;
+  }
+  if (!CJ) {
+    Eigen::JacobiSVD<MatrixXd> svd(R, Eigen::ComputeFullV);
+    V = sc.asDiagonal() * svd.matrixV().rightCols(d);
+    values = svd.singularValues().reverse();
+    return;
+  }
+  MatrixXd Cs = sc.asDiagonal() * (*CJ) * sc.asDiagonal();
+  Cs = 0.5 * (Cs + Cs.transpose()).eval();
+  Eigen::LLT<MatrixXd> llt(Cs);
+  if (llt.info() != Eigen::Success)
+    throw NumericalError("the column covariance CJ_W is singular: some parameters' regressors carry no noise "
+                         "(an input measured without noise)");
+  const MatrixXd M = llt.matrixL().solve(R.transpose()).transpose();  // R Lc^-T
+  Eigen::JacobiSVD<MatrixXd> svd(M, Eigen::ComputeFullV);
+  V = sc.asDiagonal() * llt.matrixU().solve(MatrixXd(svd.matrixV().rightCols(d)));
+  values = svd.singularValues().reverse();
+}
+
+bool all_zero(const std::vector<MimoSpectra>& data) {
+  for (const auto& d : data)
+    if (d.C.cwiseAbs().maxCoeff() != 0.0) return false;
+  return true;
+}
+
+// A Hermitian band matrix in lower band storage, ab(i - j, j) = A(i, j) for 0 <= i - j <= u,
+// and its Cholesky factor A = L L^H in the same storage: O(n u^2) to factor, O(n u) per solve.
+struct HermitianBand {
+  MatrixXcd ab;
+  int u = 0;
+  Eigen::Index n() const { return ab.cols(); }
+  cd at(Eigen::Index i, Eigen::Index j) const { return ab(i - j, j); }  // i >= j, i - j <= u
+  MatrixXcd multiply(const MatrixXcd& X) const {  // A X
+    MatrixXcd Y = MatrixXcd::Zero(X.rows(), X.cols());
+    for (Eigen::Index j = 0; j < n(); ++j)
+      for (Eigen::Index i = j; i <= std::min<Eigen::Index>(n() - 1, j + u); ++i) {
+        const cd a = at(i, j);
+        Y.row(i) += a * X.row(j);
+        if (i != j) Y.row(j) += std::conj(a) * X.row(i);
+      }
+    return Y;
+  }
+};
+
+struct BandChol {
+  HermitianBand L;
+  void factor(const HermitianBand& A) {
+    const int u = A.u;
+    const Eigen::Index n = A.n();
+    L.u = u;
+    L.ab = MatrixXcd::Zero(u + 1, n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const Eigen::Index lo = std::max<Eigen::Index>(0, j - u);
+      double s = A.at(j, j).real();
+      for (Eigen::Index k = lo; k < j; ++k) s -= std::norm(L.at(j, k));
+      if (!(s > 0) || !std::isfinite(s))
+        throw NumericalError("the residue covariance of the rows is not positive definite");
+      const double djj = std::sqrt(s);
+      L.ab(0, j) = djj;
+      const Eigen::Index hi = std::min<Eigen::Index>(n - 1, j + u);
+      for (Eigen::Index i = j + 1; i <= hi; ++i) {
+        cd v = A.at(i, j);
+        for (Eigen::Index k = std::max<Eigen::Index>(lo, i - u); k < j; ++k) v -= L.at(i, k) * std::conj(L.at(j, k));
+        L.ab(i - j, j) = v / djj;
+      }
+    }
+  }
+  MatrixXcd solve(MatrixXcd B) const {  // A^-1 B
+    const Eigen::Index n = L.n();
+    const int u = L.u;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      for (Eigen::Index k = std::max<Eigen::Index>(0, i - u); k < i; ++k) B.row(i) -= L.at(i, k) * B.row(k);
+      B.row(i) /= L.at(i, i).real();
+    }
+    for (Eigen::Index i = n - 1; i >= 0; --i) {
+      for (Eigen::Index k = i + 1; k <= std::min<Eigen::Index>(n - 1, i + u); ++k)
+        B.row(i) -= std::conj(L.at(k, i)) * B.row(k);
+      B.row(i) /= L.at(i, i).real();
+    }
+    return B;
+  }
+};
+
+// G[r][K + k] = [AA_{l,l-k}, -BB_{l,l-k}] (ny x (ny + nu)), stored one above the other in one
+// matrix: block (r (2K+1) + K + k) of ny rows.
+struct BandBlocks {
+  MatrixXcd m;
+  int ny = 1, width = 1;
+  Eigen::Block<const MatrixXcd> operator()(int r, int kk) const {
+    return m.block((static_cast<Eigen::Index>(r) * width + kk) * ny, 0, ny, m.cols());
+  }
+};
+
+BandBlocks band_blocks(const Params& p, const MatrixXcd& Th, const std::vector<int>& rows) {
+  BandBlocks G;
+  G.ny = p.ny;
+  G.width = 2 * p.K + 1;
+  G.m = MatrixXcd::Zero(static_cast<Eigen::Index>(rows.size()) * G.width * p.ny, p.nc());
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (int j = 0; j < p.nphi; ++j) {
+      const cd f = (p.is_a[j] ? 1.0 : -1.0) * ipow(p.s(rows[r] - p.k[j]), p.order[j]);
+      const Eigen::Index top = (static_cast<Eigen::Index>(r) * G.width + p.K + p.k[j]) * p.ny;
+      for (int q = 0; q < p.ny; ++q) G.m(top + q, p.channel[j]) += f * Th(j, q);
+    }
+  return G;
+}
+
+// C_E of one experiment's rows (scalar index ny r + p): rows r and r + o share the lines
+// i = l - k = l' - k' when l' - l <= 2K; half bandwidth (2K + 1) ny - 1.
+HermitianBand row_covariance(const Prep& x, const Params& p, const BandBlocks& G) {
+  const MimoSpectra& d = *x.d;
+  const int R = x.R(), ny = p.ny, K = p.K, c = p.nc();
+  HermitianBand A;
+  A.u = (2 * K + 1) * ny - 1;
+  A.ab = MatrixXcd::Zero(A.u + 1, static_cast<Eigen::Index>(R) * ny);
+  MatrixXcd blk(ny, ny);
+  for (int r = 0; r < R; ++r)
+    for (int o = 0; o <= 2 * K && r + o < R; ++o) {
+      const int dl = d.rows[r + o] - d.rows[r];
+      blk.setZero();
+      for (int kk = 0; kk <= 2 * K; ++kk) {
+        const int k2 = kk + dl;
+        if (k2 > 2 * K) continue;
+        const int i = d.rows[r] - (kk - K);
+        blk.noalias() += G(r, kk) * d.C.block(static_cast<Eigen::Index>(i) * c, 0, c, c) * G(r + o, k2).adjoint();
+      }
+      for (int pp = 0; pp < ny; ++pp)
+        for (int q = 0; q < ny; ++q) {
+          if (o == 0) {
+            if (pp >= q) A.ab(pp - q, r * ny + q) = blk(pp, q);
+          } else {
+            A.ab(o * ny + q - pp, r * ny + pp) = std::conj(blk(pp, q));  // entry ((r+o) ny + q, r ny + p)
+          }
+        }
+    }
+  return A;
+}
+
+VectorXcd stacked(const MatrixXcd& E) {  // rows x ny -> index r ny + p
+  VectorXcd v(E.size());
+  for (Eigen::Index r = 0; r < E.rows(); ++r)
+    for (Eigen::Index q = 0; q < E.cols(); ++q) v(r * E.cols() + q) = E(r, q);
+  return v;
+}
+
+// d e / d xi at the denoised spectra z0_i = z_i - C_i sum_l G_{l,i}^H w_l, free columns only.
+MatrixXcd jacobian0(const Prep& x, const Params& p, const BandBlocks& G,
+                    const VectorXcd& w, const std::vector<int>& free) {
+  const MimoSpectra& d = *x.d;
+  const int R = x.R(), ny = p.ny, c = p.nc(), K = p.K;
+  const Eigen::Index L1 = d.Y.rows();
+  MatrixXcd corr = MatrixXcd::Zero(L1, c);
+  for (int r = 0; r < R; ++r)
+    for (int kk = 0; kk <= 2 * K; ++kk)
+      corr.row(d.rows[r] - (kk - K)) += (G(r, kk).adjoint() * w.segment(r * ny, ny)).transpose();
+  MatrixXcd Y0 = d.Y, U0 = d.U;
+  for (Eigen::Index i = 0; i < L1; ++i) {
+    const VectorXcd dz = d.C.block(i * c, 0, c, c) * corr.row(i).transpose();
+    Y0.row(i) -= dz.head(ny).transpose();
+    U0.row(i) -= dz.tail(p.nu).transpose();
+  }
+  const MatrixXcd Psi0 = regressors(p, d.rows, Y0, U0) * p.T;
+  MatrixXcd J = MatrixXcd::Zero(R * ny, free.size());
+  for (size_t f = 0; f < free.size(); ++f) {
+    const int pp = free[f] / p.nrow, i = free[f] % p.nrow;
+    for (int r = 0; r < R; ++r) J(r * ny + pp, f) = Psi0(r, i);
+  }
+  return J;
+}
+
+struct Evaluation {
+  double cost = 0.0;
+  VectorXd grad;
+  MatrixXd F;
+};
+
+Evaluation evaluate(const std::vector<Prep>& preps, const Params& p, const VectorXd& xi, const std::vector<int>& free,
+                    bool derivatives) {
+  const MatrixXcd Th = theta_of(p, xi);
+  Evaluation ev;
+  ev.grad = VectorXd::Zero(free.size());
+  ev.F = MatrixXd::Zero(free.size(), free.size());
+  for (const Prep& x : preps) {
+    const VectorXcd e = stacked(x.Phi * Th);
+    const auto G = band_blocks(p, Th, x.d->rows);
+    BandChol ch;
+    ch.factor(row_covariance(x, p, G));
+    const VectorXcd w = ch.solve(e);
+    ev.cost += e.dot(w).real();
+    if (!derivatives) continue;
+    const MatrixXcd J0 = jacobian0(x, p, G, w, free);
+    ev.grad += 2.0 * (J0.adjoint() * w).real();
+    ev.F += 2.0 * (J0.adjoint() * ch.solve(J0)).real();
+  }
+  return ev;
+}
+
+std::vector<Prep> prepare_all(const std::vector<MimoSpectra>& data, const Params& p) {
+  check(data, p);
+  std::vector<Prep> out;
+  for (const auto& d : data) out.push_back(prepare(d, p));
+  return out;
+}
+
+Params checked_params(const MimoStructure& s, const VectorXd* xi) {
+  Params p = make_params(s);
+  if (xi && xi->size() != p.nxi())
+    throw std::invalid_argument("xi: must have " + std::to_string(p.nxi()) + " entries, got " +
+                                std::to_string(xi->size()));
+  if (xi && !xi->allFinite()) throw std::invalid_argument("xi: contains NaN or inf");
+  return p;
+}
+
+}  // namespace
+
+std::vector<int> mimo_free_indices(const MimoStructure& s) {
+  const Params p = make_params(s);
+  std::vector<bool> fixed(p.nxi(), false);
+  for (int pp = 0; pp < p.ny; ++pp)
+    for (int q = 0; q < p.ny; ++q) fixed[pp * p.nrow + p.fixed_row[q]] = true;
+  std::vector<int> out;
+  for (int j = 0; j < p.nxi(); ++j)
+    if (!fixed[j]) out.push_back(j);
+  return out;
+}
+
+MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructure& s, double tol, int max_iter,
+                        bool weighted) {
+  const Params p = checked_params(s, nullptr);
+  const std::vector<Prep> preps = prepare_all(data, p);
+  MimoEstimate out;
+  out.noise_free = all_zero(data);
+  Eigen::Index rows = 0;
+  for (const Prep& x : preps) rows += 2 * x.R() * p.ny;
+  const int d = p.ny * p.ny;
+  auto solve = [&](const std::vector<std::vector<MatrixXcd>>* Ws) {
+    MatrixXd J(rows, p.nxi());
+    MatrixXd CJ = MatrixXd::Zero(p.nxi(), p.nxi());
+    // the Re and Im halves of all experiments: experiment e's rows at its offset in each half
+    Eigen::Index at = 0;
+    MatrixXd Jpart;
+    for (size_t e = 0; e < preps.size(); ++e) {
+      const Eigen::Index re = static_cast<Eigen::Index>(preps[e].R()) * p.ny;
+      Jpart.resize(2 * re, p.nxi());
+      Eigen::Index a = 0;
+      whitened(preps[e], p, Ws ? &(*Ws)[e] : nullptr, Jpart, a, CJ);
+      J.middleRows(2 * at, 2 * re) = Jpart;
+      at += re;
+    }
+    MatrixXd V;
+    subspace(J, out.noise_free ? nullptr : &CJ, d, V, out.singular_values);
+    out.xi = normalise(V, p);
+  };
+  solve(nullptr);
+  out.iterations = 0;
+  out.converged = true;
+  if (!weighted || out.noise_free) return out;
+  out.converged = false;
+  for (int it = 1; it <= max_iter; ++it) {
+    const MatrixXcd Th = theta_of(p, out.xi);
+    std::vector<std::vector<MatrixXcd>> Ws;
+    for (const Prep& x : preps) Ws.push_back(weights(line_covariances(x, Th)));
+    const VectorXd prev = out.xi;
+    solve(&Ws);
+    out.iterations = it;
+    if ((out.xi - prev).norm() <= tol * out.xi.norm()) {
+      out.converged = true;
+      break;
+    }
+  }
+  return out;
+}
+
+MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi0, double tol,
+                      int max_iter) {
+  const Params p = checked_params(s, &xi0);
+  const std::vector<Prep> preps = prepare_all(data, p);
+  const std::vector<int> free = mimo_free_indices(s);
+  const double eps = std::numeric_limits<double>::epsilon();
+  MimoEstimate out;
+  out.xi = xi0;
+  Evaluation ev = evaluate(preps, p, out.xi, free, true);
+  double mu = 1e-6;
+  int steps = 0;
+  bool converged = false;
+  while (steps < max_iter) {
+    const double dmax = ev.F.diagonal().maxCoeff();
+    const VectorXd D = ev.F.diagonal().cwiseMax(eps * dmax);
+    MatrixXd A = ev.F;
+    A.diagonal() += mu * D;
+    Eigen::LLT<MatrixXd> llt(A);
+    bool tried = false;
+    if (llt.info() == Eigen::Success) {
+      const VectorXd step = -llt.solve(ev.grad);
+      const double pred = -(ev.grad.dot(step) + 0.5 * step.dot(ev.F * step));
+      if (pred <= 8 * eps * std::max(ev.cost, 1.0)) {
+        converged = true;
+        break;
+      }
+      VectorXd trial = out.xi;
+      for (size_t f = 0; f < free.size(); ++f) trial(free[f]) += step(f);
+      const double c_new = evaluate(preps, p, trial, free, false).cost;
+      tried = true;
+      if (c_new < ev.cost) {
+        out.xi = trial;
+        ++steps;
+        mu = std::max(mu / 10.0, 1e-12);
+        ev = evaluate(preps, p, out.xi, free, true);
+        double nx = 0.0;
+        for (int f : free) nx += out.xi(f) * out.xi(f);
+        if (step.norm() <= tol * std::sqrt(nx)) {
+          converged = true;
+          break;
+        }
+        continue;
+      }
+    }
+    (void)tried;
+    mu *= 10.0;
+    if (mu > 1e12) {
+      converged = true;  // no step lowers the cost: a minimum to rounding
+      break;
+    }
+  }
+  out.cost = ev.cost;
+  out.information = ev.F;
+  out.iterations = steps;
+  out.converged = converged;
+  return out;
+}
+
+MatrixXd mimo_fisher(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
+  const Params p = checked_params(s, &xi);
+  return evaluate(prepare_all(data, p), p, xi, mimo_free_indices(s), true).F;
+}
+
+MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
+  const Params p = checked_params(s, &xi);
+  const std::vector<Prep> preps = prepare_all(data, p);
+  const std::vector<int> free = mimo_free_indices(s);
+  const MatrixXcd Th = theta_of(p, xi);
+  const Eigen::Index nf = static_cast<Eigen::Index>(free.size());
+  MatrixXd H = MatrixXd::Zero(nf, nf), Mt = MatrixXd::Zero(nf, nf);
+  for (const Prep& x : preps) {
+    const VectorXcd e = stacked(x.Phi * Th);
+    const auto G = band_blocks(p, Th, x.d->rows);
+    const HermitianBand CE = row_covariance(x, p, G);
+    BandChol ch;
+    ch.factor(CE);
+    const MatrixXcd J = jacobian0(x, p, G, ch.solve(e), free);
+    const auto W = weights(line_covariances(x, Th));
+    MatrixXcd WJ(J.rows(), nf);
+    for (int r = 0; r < x.R(); ++r) WJ.middleRows(r * p.ny, p.ny) = W[r] * J.middleRows(r * p.ny, p.ny);
+    H += (J.adjoint() * WJ).real();
+    Mt += 0.5 * (WJ.adjoint() * CE.multiply(WJ)).real();
+  }
+  const MatrixXd Hi = H.inverse();
+  return Hi * Mt * Hi;
+}
+
+void mimo_residues(const MimoSpectra& d, const MimoStructure& s, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
+  const Params p = checked_params(s, &xi);
+  const std::vector<MimoSpectra> one{d};
+  check(one, p);
+  const Prep x = prepare(d, p);
+  const MatrixXcd Th = theta_of(p, xi);
+  e = x.Phi * Th;
+  const auto C = line_covariances(x, Th);
+  Ce.resize(static_cast<Eigen::Index>(C.size()) * p.ny, p.ny);
+  for (size_t r = 0; r < C.size(); ++r) Ce.middleRows(static_cast<Eigen::Index>(r) * p.ny, p.ny) = C[r];
+}
+
+}  // namespace lptv
