@@ -26,7 +26,7 @@ from conftest import (MIMO_FLOQUET_DT, MIMO_FLOQUET_IVP_RTOL, MIMO_FLOQUET_KAPPA
                       MIMO_FLOQUET_SISO, MIMO_FLOQUET_VS_IVP, MIMO_FROZEN_POLES, SEEDS)
 
 
-# ------------------------------------------------------------------------------ helpers (NumPy)
+# ------------------------------------------------------------------------------ the NumPy routes
 
 def fourier(c, w0, t, derivative=0):
     """sum_k c[..., K + k] (j k w0)^d exp(j k w0 t), real part (the coefficients are symmetric)."""
