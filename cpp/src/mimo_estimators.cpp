@@ -170,8 +170,27 @@ Prep prepare(const MimoSpectra& d, const Params& p) {
 }
 
 std::vector<MatrixXcd> line_covariances(const Prep& x, const MatrixXcd& Th) {
+  // C_{e,l} = Theta^T conj(Cphi_l) conj(Theta), explicit loops over the small blocks
+  const Eigen::Index n = Th.rows(), ny = Th.cols();
   std::vector<MatrixXcd> out(x.R());
-  for (int r = 0; r < x.R(); ++r) out[r] = Th.transpose() * x.Cphi[r].conjugate() * Th.conjugate();
+  MatrixXcd v(n, ny);
+  for (int r = 0; r < x.R(); ++r) {
+    const MatrixXcd& Cp = x.Cphi[r];
+    for (Eigen::Index q = 0; q < ny; ++q)
+      for (Eigen::Index a = 0; a < n; ++a) {
+        cd acc(0.0, 0.0);
+        for (Eigen::Index b = 0; b < n; ++b) acc += std::conj(Cp(a, b) * Th(b, q));
+        v(a, q) = acc;
+      }
+    MatrixXcd& C = out[r];
+    C.resize(ny, ny);
+    for (Eigen::Index pp = 0; pp < ny; ++pp)
+      for (Eigen::Index q = 0; q < ny; ++q) {
+        cd acc(0.0, 0.0);
+        for (Eigen::Index a = 0; a < n; ++a) acc += Th(a, pp) * v(a, q);
+        C(pp, q) = acc;
+      }
+  }
   return out;
 }
 
@@ -266,9 +285,33 @@ void subspace(const MatrixXd& Jx, const MatrixXd* CJ, int d, MatrixXd& V, Vector
   MatrixXd Cs = sc.asDiagonal() * (*CJ) * sc.asDiagonal();
   Cs = 0.5 * (Cs + Cs.transpose()).eval();
   Eigen::LLT<MatrixXd> llt(Cs);
-  if (llt.info() != Eigen::Success)
-    throw NumericalError("the column covariance CJ_W is singular: some parameters' regressors carry no noise "
-                         "(an input measured without noise)");
+  if (llt.info() != Eigen::Success) {
+    // Some directions carry no noise (an input measured without noise): they have no
+    // denominator, so they are eliminated by least squares (the GSVD's infinite values) and the
+    // ratio is minimised over the noisy directions z, whitened by CJ_W's eigenvalues there.
+    Eigen::SelfAdjointEigenSolver<MatrixXd> es(Cs);
+    const VectorXd& lam = es.eigenvalues();
+    const double cut = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * lam.maxCoeff();
+    std::vector<Eigen::Index> i1, i2;
+    for (Eigen::Index j = 0; j < n; ++j) (lam(j) > cut ? i1 : i2).push_back(j);
+    if (static_cast<int>(i1.size()) < d)
+      throw NumericalError("the column covariance CJ_W has fewer noisy directions than the equivalent models");
+    MatrixXd B1(n, i1.size()), A2(R.rows(), i2.size());
+    for (size_t j = 0; j < i1.size(); ++j) B1.col(j) = es.eigenvectors().col(i1[j]) / std::sqrt(lam(i1[j]));
+    for (size_t j = 0; j < i2.size(); ++j) A2.col(j) = R * es.eigenvectors().col(i2[j]);
+    const MatrixXd A1 = R * B1;
+    Eigen::ColPivHouseholderQR<MatrixXd> qr2(A2);
+    const MatrixXd Qa = MatrixXd(qr2.householderQ()).leftCols(qr2.rank());
+    const MatrixXd P = A1 - Qa * (Qa.transpose() * A1);
+    Eigen::JacobiSVD<MatrixXd> svd(P, Eigen::ComputeFullV);
+    const MatrixXd Z = svd.matrixV().rightCols(d);
+    const MatrixXd Y2 = -qr2.solve(MatrixXd(A1 * Z));
+    MatrixXd X = B1 * Z;
+    for (size_t j = 0; j < i2.size(); ++j) X += es.eigenvectors().col(i2[j]) * Y2.row(j);
+    V = sc.asDiagonal() * X;
+    values = svd.singularValues().reverse();
+    return;
+  }
   const MatrixXd M = llt.matrixL().solve(R.transpose()).transpose();  // R Lc^-T
   Eigen::JacobiSVD<MatrixXd> svd(M, Eigen::ComputeFullV);
   V = sc.asDiagonal() * llt.matrixU().solve(MatrixXd(svd.matrixV().rightCols(d)));
@@ -371,23 +414,44 @@ HermitianBand row_covariance(const Prep& x, const Params& p, const BandBlocks& G
   HermitianBand A;
   A.u = (2 * K + 1) * ny - 1;
   A.ab = MatrixXcd::Zero(A.u + 1, static_cast<Eigen::Index>(R) * ny);
-  MatrixXcd blk(ny, ny);
+  // H[r, kk] = G(r, kk) C_{l-k} once per row and line (ny x c), then each pair of rows sums
+  // H G'^H over the lines they share; explicit loops: the blocks are a few entries each
+  const int W = 2 * K + 1;
+  MatrixXcd H(static_cast<Eigen::Index>(R) * W * ny, c);
+  for (int r = 0; r < R; ++r)
+    for (int kk = 0; kk < W; ++kk) {
+      const int i = d.rows[r] - (kk - K);
+      const Eigen::Index top = (static_cast<Eigen::Index>(r) * W + kk) * ny;
+      for (int pp = 0; pp < ny; ++pp)
+        for (int b = 0; b < c; ++b) {
+          cd v(0.0, 0.0);
+          for (int a = 0; a < c; ++a) v += G.m(top + pp, a) * d.C(static_cast<Eigen::Index>(i) * c + a, b);
+          H(top + pp, b) = v;
+        }
+    }
+  std::vector<cd> blk(static_cast<size_t>(ny) * ny);
   for (int r = 0; r < R; ++r)
     for (int o = 0; o <= 2 * K && r + o < R; ++o) {
       const int dl = d.rows[r + o] - d.rows[r];
-      blk.setZero();
-      for (int kk = 0; kk <= 2 * K; ++kk) {
+      std::fill(blk.begin(), blk.end(), cd(0.0, 0.0));
+      for (int kk = 0; kk < W; ++kk) {
         const int k2 = kk + dl;
         if (k2 > 2 * K) continue;
-        const int i = d.rows[r] - (kk - K);
-        blk.noalias() += G(r, kk) * d.C.block(static_cast<Eigen::Index>(i) * c, 0, c, c) * G(r + o, k2).adjoint();
+        const Eigen::Index h = (static_cast<Eigen::Index>(r) * W + kk) * ny;
+        const Eigen::Index g = (static_cast<Eigen::Index>(r + o) * W + k2) * ny;
+        for (int pp = 0; pp < ny; ++pp)
+          for (int q = 0; q < ny; ++q) {
+            cd v(0.0, 0.0);
+            for (int b = 0; b < c; ++b) v += H(h + pp, b) * std::conj(G.m(g + q, b));
+            blk[pp * ny + q] += v;
+          }
       }
       for (int pp = 0; pp < ny; ++pp)
         for (int q = 0; q < ny; ++q) {
           if (o == 0) {
-            if (pp >= q) A.ab(pp - q, r * ny + q) = blk(pp, q);
+            if (pp >= q) A.ab(pp - q, r * ny + q) = blk[pp * ny + q];
           } else {
-            A.ab(o * ny + q - pp, r * ny + pp) = std::conj(blk(pp, q));  // entry ((r+o) ny + q, r ny + p)
+            A.ab(o * ny + q - pp, r * ny + pp) = std::conj(blk[pp * ny + q]);  // entry ((r+o) ny + q, r ny + p)
           }
         }
     }
@@ -410,7 +474,12 @@ MatrixXcd jacobian0(const Prep& x, const Params& p, const BandBlocks& G,
   MatrixXcd corr = MatrixXcd::Zero(L1, c);
   for (int r = 0; r < R; ++r)
     for (int kk = 0; kk <= 2 * K; ++kk)
-      corr.row(d.rows[r] - (kk - K)) += (G(r, kk).adjoint() * w.segment(r * ny, ny)).transpose();
+      for (int b = 0; b < c; ++b) {
+        cd v(0.0, 0.0);
+        const Eigen::Index top = (static_cast<Eigen::Index>(r) * (2 * K + 1) + kk) * ny;
+        for (int pp = 0; pp < ny; ++pp) v += std::conj(G.m(top + pp, b)) * w(r * ny + pp);
+        corr(d.rows[r] - (kk - K), b) += v;
+      }
   MatrixXcd Y0 = d.Y, U0 = d.U;
   for (Eigen::Index i = 0; i < L1; ++i) {
     const VectorXcd dz = d.C.block(i * c, 0, c, c) * corr.row(i).transpose();
@@ -471,8 +540,9 @@ Params checked_params(const MimoStructure& s, const VectorXd* xi) {
 
 }  // namespace
 
-std::vector<int> mimo_free_indices(const MimoStructure& s) {
-  const Params p = make_params(s);
+namespace {
+
+std::vector<int> free_of(const Params& p) {
   std::vector<bool> fixed(p.nxi(), false);
   for (int pp = 0; pp < p.ny; ++pp)
     for (int q = 0; q < p.ny; ++q) fixed[pp * p.nrow + p.fixed_row[q]] = true;
@@ -482,12 +552,10 @@ std::vector<int> mimo_free_indices(const MimoStructure& s) {
   return out;
 }
 
-MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructure& s, double tol, int max_iter,
+MimoEstimate wgtls_impl(const std::vector<Prep>& preps, const Params& p, bool noise_free, double tol, int max_iter,
                         bool weighted) {
-  const Params p = checked_params(s, nullptr);
-  const std::vector<Prep> preps = prepare_all(data, p);
   MimoEstimate out;
-  out.noise_free = all_zero(data);
+  out.noise_free = noise_free;
   Eigen::Index rows = 0;
   for (const Prep& x : preps) rows += 2 * x.R() * p.ny;
   const int d = p.ny * p.ny;
@@ -529,11 +597,8 @@ MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructur
   return out;
 }
 
-MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi0, double tol,
-                      int max_iter) {
-  const Params p = checked_params(s, &xi0);
-  const std::vector<Prep> preps = prepare_all(data, p);
-  const std::vector<int> free = mimo_free_indices(s);
+MimoEstimate sml_impl(const std::vector<Prep>& preps, const Params& p, const VectorXd& xi0, double tol, int max_iter) {
+  const std::vector<int> free = free_of(p);
   const double eps = std::numeric_limits<double>::epsilon();
   MimoEstimate out;
   out.xi = xi0;
@@ -587,15 +652,8 @@ MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure&
   return out;
 }
 
-MatrixXd mimo_fisher(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
-  const Params p = checked_params(s, &xi);
-  return evaluate(prepare_all(data, p), p, xi, mimo_free_indices(s), true).F;
-}
-
-MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
-  const Params p = checked_params(s, &xi);
-  const std::vector<Prep> preps = prepare_all(data, p);
-  const std::vector<int> free = mimo_free_indices(s);
+MatrixXd sandwich_impl(const std::vector<Prep>& preps, const Params& p, const VectorXd& xi) {
+  const std::vector<int> free = free_of(p);
   const MatrixXcd Th = theta_of(p, xi);
   const Eigen::Index nf = static_cast<Eigen::Index>(free.size());
   MatrixXd H = MatrixXd::Zero(nf, nf), Mt = MatrixXd::Zero(nf, nf);
@@ -616,16 +674,79 @@ MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure
   return Hi * Mt * Hi;
 }
 
-void mimo_residues(const MimoSpectra& d, const MimoStructure& s, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
-  const Params p = checked_params(s, &xi);
-  const std::vector<MimoSpectra> one{d};
-  check(one, p);
-  const Prep x = prepare(d, p);
+void residues_impl(const Prep& x, const Params& p, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
   const MatrixXcd Th = theta_of(p, xi);
   e = x.Phi * Th;
   const auto C = line_covariances(x, Th);
   Ce.resize(static_cast<Eigen::Index>(C.size()) * p.ny, p.ny);
   for (size_t r = 0; r < C.size(); ++r) Ce.middleRows(static_cast<Eigen::Index>(r) * p.ny, p.ny) = C[r];
+}
+
+}  // namespace
+
+std::vector<int> mimo_free_indices(const MimoStructure& s) { return free_of(make_params(s)); }
+
+MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructure& s, double tol, int max_iter,
+                        bool weighted) {
+  const Params p = checked_params(s, nullptr);
+  return wgtls_impl(prepare_all(data, p), p, all_zero(data), tol, max_iter, weighted);
+}
+
+MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi0, double tol,
+                      int max_iter) {
+  const Params p = checked_params(s, &xi0);
+  return sml_impl(prepare_all(data, p), p, xi0, tol, max_iter);
+}
+
+MatrixXd mimo_fisher(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
+  const Params p = checked_params(s, &xi);
+  return evaluate(prepare_all(data, p), p, xi, free_of(p), true).F;
+}
+
+MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
+  const Params p = checked_params(s, &xi);
+  return sandwich_impl(prepare_all(data, p), p, xi);
+}
+
+void mimo_residues(const MimoSpectra& d, const MimoStructure& s, const VectorXd& xi, MatrixXcd& e, MatrixXcd& Ce) {
+  const Params p = checked_params(s, &xi);
+  const std::vector<MimoSpectra> one{d};
+  check(one, p);
+  residues_impl(prepare(d, p), p, xi, e, Ce);
+}
+
+MimoFit mimo_fit(const std::vector<MimoSpectra>& data, const MimoStructure& s, const std::string& method, double tol,
+                 int max_iter, bool covariance) {
+  if (method != "gtls" && method != "wgtls" && method != "sml")
+    throw std::invalid_argument("method: must be 'gtls', 'wgtls' or 'sml', got '" + method + "'");
+  const Params p = checked_params(s, nullptr);
+  const std::vector<Prep> preps = prepare_all(data, p);
+  MimoFit out;
+  out.estimate = wgtls_impl(preps, p, all_zero(data), tol, max_iter, method != "gtls");
+  const bool noisy = !out.estimate.noise_free;
+  if (method == "sml" && noisy) out.estimate = sml_impl(preps, p, out.estimate.xi, tol, max_iter);
+  if (covariance && noisy) {
+    if (method == "sml") {
+      Eigen::LLT<MatrixXd> llt(out.estimate.information);
+      if (llt.info() != Eigen::Success) throw NumericalError("the Fisher information is not positive definite");
+      out.covariance = llt.solve(MatrixXd::Identity(out.estimate.information.rows(), out.estimate.information.cols()));
+    } else {
+      out.covariance = sandwich_impl(preps, p, out.estimate.xi);
+    }
+  }
+  Eigen::Index rows = 0;
+  for (const Prep& x : preps) rows += x.R();
+  out.residues.resize(rows, p.ny);
+  out.residue_covariance.resize(rows * p.ny, p.ny);
+  Eigen::Index at = 0;
+  for (const Prep& x : preps) {
+    MatrixXcd e, Ce;
+    residues_impl(x, p, out.estimate.xi, e, Ce);
+    out.residues.middleRows(at, x.R()) = e;
+    out.residue_covariance.middleRows(at * p.ny, x.R() * p.ny) = Ce;
+    at += x.R();
+  }
+  return out;
 }
 
 }  // namespace lptv

@@ -90,6 +90,13 @@ py::tuple residues_py(const SpectraTuple& data, const lptv::MimoStructure& s, co
   return py::make_tuple(e, Ce);
 }
 
+lptv::MimoFit fit_py(const std::vector<SpectraTuple>& data, const lptv::MimoStructure& s, const std::string& method,
+                     double tol, int max_iter, bool covariance) {
+  const auto d = spectra_of(data);
+  py::gil_scoped_release release;  // pure C++ work on copies
+  return lptv::mimo_fit(d, s, method, tol, max_iter, covariance);
+}
+
 lptv::MimoStructure make_structure(int ny, int nu, const Eigen::MatrixXi& ka, const Eigen::MatrixXi& kb, double w0,
                                    double ts) {
   lptv::MimoStructure s;
@@ -140,6 +147,14 @@ void bind_mimo(py::module_& m) {
       .def_readonly("iterations", &lptv::MimoEstimate::iterations)
       .def_readonly("converged", &lptv::MimoEstimate::converged)
       .def_readonly("noise_free", &lptv::MimoEstimate::noise_free);
+  py::class_<lptv::MimoFit>(m, "MimoFit", "One MIMO fit: estimate, covariance (free entries), residues.")
+      .def_readonly("estimate", &lptv::MimoFit::estimate)
+      .def_readonly("covariance", &lptv::MimoFit::covariance)
+      .def_readonly("residues", &lptv::MimoFit::residues)
+      .def_readonly("residue_covariance", &lptv::MimoFit::residue_covariance);
+  m.def("mimo_fit", &fit_py, "data"_a, "structure"_a, "method"_a, "tol"_a, "max_iter"_a, "covariance"_a = true,
+        "WGTLS ('gtls', 'wgtls') or SML ('sml') from WGTLS with the covariance and the residues, the rows' terms "
+        "formed once");
   m.def("mimo_wgtls", &wgtls_py, "data"_a, "structure"_a, "tol"_a, "max_iter"_a, "weighted"_a = true,
         "WGTLS with vector residues and A_na,0 = I; data: list of (Y, U, C, rows), C of shape ((L+1)(ny+nu), ny+nu)");
   m.def("mimo_sml", &sml_py, "data"_a, "structure"_a, "xi0"_a, "tol"_a, "max_iter"_a,

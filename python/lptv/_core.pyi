@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -620,6 +620,22 @@ class MimoEstimate:
     @property
     def xi(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
+class MimoFit:
+    """
+    One MIMO fit: estimate, covariance (free entries), residues.
+    """
+    @property
+    def covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
+    @property
+    def estimate(self) -> MimoEstimate:
+        ...
+    @property
+    def residue_covariance(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
+    @property
+    def residues(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
 class Floquet:
     """
     Characteristic multipliers and Floquet exponents (lptv::floquet).
@@ -796,6 +812,10 @@ def mimo_band_matrix(model: MimoModel, L: typing.SupportsInt | typing.SupportsIn
 def mimo_fisher(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     """
     Fisher information over the free entries
+    """
+def mimo_fit(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, method: str, tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex, covariance: bool = True) -> MimoFit:
+    """
+    WGTLS ('gtls', 'wgtls') or SML ('sml') from WGTLS with the covariance and the residues, the rows' terms formed once
     """
 def mimo_free_indices(structure: MimoStructure) -> list[int]:
     ...

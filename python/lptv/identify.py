@@ -106,7 +106,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     (the exact likelihood of the rows); covariance 'analytic' (SML: the inverse Fisher
     information; WGTLS: the first-order sandwich; both times (P-1)/(P-3)) or 'none';
     ``lines`` None (every usable line K+1..N/2-K), 'excited', a sequence, or one entry per
-    experiment. 2-D arrays stay the single-input single-output fit below.
+    experiment; ``known={'a<na>': M}`` (M real, invertible, ny x ny) fixes the leading matrix's
+    mean to M instead of I (the estimate and its covariance are the A_na,0 = I ones multiplied by
+    M from the left). 2-D arrays stay the single-input single-output fit below.
 
     Parameters
     ----------
@@ -223,6 +225,16 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     >>> res = lptv.identify(u, y, na=1, nb=0, w0=0.1)
     >>> np.round(res.model.a[:, 0].real, 2)
     array([2., 1.])
+
+    One input and two outputs, arrays of shape (P, N, nu) and (P, N, ny):
+
+    >>> a = np.zeros((2, 2, 2)); a[1] = np.eye(2); a[0] = [[2.0, 0.5], [0.0, 3.0]]
+    >>> mm = lptv.MimoModel(a, np.ones((1, 2, 1)), w0=0.1)
+    >>> Y = lptv.simulate(mm, ms.spectrum[:, None], lines_out=128)
+    >>> y2 = np.fft.irfft(Y * 256, 256, axis=0)[None] + 1e-3 * rng.standard_normal((4, 256, 2))
+    >>> r2 = lptv.identify(u[:, :, None], y2, na=1, nb=0, w0=0.1)
+    >>> r2.model.n_outputs, (np.round(r2.model.a[0, :, :, 0].real, 2) + 0.0).tolist(), r2.model_ok
+    (2, [[2.0, 0.5], [0.0, 3.0]], True)
     """
     if is_mimo(u, y):
         if noise != "sample" or disturbances is not None:

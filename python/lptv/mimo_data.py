@@ -40,6 +40,23 @@ class MimoFrequencyData:
     w0: float
     ts: Optional[float] = None
 
+    def __post_init__(self):
+        U, Y, C = (np.asarray(_array(x, n)) for x, n in ((self.U, "U"), (self.Y, "Y"), (self.C, "C")))
+        if U.ndim != 2 or min(U.shape) < 1:
+            raise ValueError(f"U must have shape (L+1, nu), got {U.shape}")
+        if Y.ndim != 2 or Y.shape[0] != U.shape[0] or Y.shape[1] < 1:
+            raise ValueError(f"Y must have shape (L+1, ny) with the lines of U ({U.shape[0]}), got {Y.shape}")
+        c = U.shape[1] + Y.shape[1]
+        if C.shape != (U.shape[0], c, c):
+            raise ValueError(f"C must have shape (L+1, ny+nu, ny+nu) = {(U.shape[0], c, c)}, got {C.shape}")
+        for x, n in ((U, "U"), (Y, "Y"), (C, "C")):
+            check_finite(x, n)
+        if isinstance(self.periods, bool) or int(self.periods) != self.periods or self.periods < 0:
+            raise ValueError(f"periods must be a non-negative integer, got {self.periods!r}")
+        object.__setattr__(self, "U", U.astype(complex))
+        object.__setattr__(self, "Y", Y.astype(complex))
+        object.__setattr__(self, "C", C.astype(complex))
+
     n_inputs = property(lambda self: self.U.shape[1])
     n_outputs = property(lambda self: self.Y.shape[1])
     max_line = property(lambda self: self.U.shape[0] - 1)
@@ -54,10 +71,14 @@ class MimoFrequencyData:
                              f"got shape {y.shape}")
         P, N = u.shape[:2]
         if P < 2:
-            raise ValueError(f"u: {P} period: the noise (co)variances need P >= 2 periods (shape (P, N, nu))")
+            raise ValueError(f"u must hold P >= 2 periods for the noise (co)variances (shape (P, N, nu)), got {P}")
         z = np.concatenate([np.fft.rfft(y, axis=1), np.fft.rfft(u, axis=1)], axis=2) / N
-        zm = z.mean(axis=0)
-        dz = z - zm
+        # deviations from the first period, so that a channel whose periods are identical (an
+        # input measured without noise) has exactly zero (co)variances, not rounding
+        w = z - z[0]
+        wm = w.mean(axis=0)
+        zm = z[0] + wm
+        dz = w - wm
         C = np.einsum("plc,pld->lcd", dz, dz.conj()) / (P * (P - 1))
         ny = y.shape[2]
         return cls(U=zm[:, ny:].copy(), Y=zm[:, :ny].copy(), C=C, periods=P, w0=_w0(w0), ts=_ts(ts))

@@ -47,6 +47,19 @@ def _call(f, *args):
         raise FitError(str(err)) from None
 
 
+def fit(data, cst, method, *, tol=1e-10, max_iter=50, covariance=True):
+    """One fit in the core: (xi, iterations, converged, singular values, noise_free, SML's cost or
+    None, the covariance over the free entries or None, residues (rows, ny), C_{e,l} (rows, ny, ny))."""
+    r = _call(_core.mimo_fit, data, cst, method, float(tol), int(max_iter), bool(covariance))
+    est = r.estimate
+    res = np.asarray(r.residues)
+    Ce = np.asarray(r.residue_covariance).reshape(res.shape[0], res.shape[1], res.shape[1])
+    cov = np.asarray(r.covariance) if r.covariance.size else None
+    cost = float(est.cost) if method == "sml" and not est.noise_free else None
+    return (np.asarray(est.xi), est.iterations, est.converged, np.asarray(est.singular_values), est.noise_free,
+            cost, cov, res, Ce)
+
+
 def wgtls(data, cst, *, tol=1e-10, max_iter=50, method="wgtls"):
     """WGTLS (or GTLS) with vector residues: xi, iterations, converged, singular values, noise_free."""
     r = _call(_core.mimo_wgtls, data, cst, float(tol), int(max_iter), method == "wgtls")

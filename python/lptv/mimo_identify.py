@@ -12,7 +12,7 @@ import numpy as np
 from ._validate import _array, as_float, as_int, as_lines, check_finite
 from .mimo import MimoModel
 from .mimo_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
-from .mimo_fit import FitError, core_data, core_structure, expand, fisher, residues, sandwich, sml, wgtls
+from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit
 from .mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
@@ -102,6 +102,24 @@ def _rows_of(d: MimoFrequencyData, lines, K: int, e: int):
     return rows
 
 
+def _known_leading(known, na, ny):
+    """known={'a<na>': M}: the mean of the leading matrix, ny x ny real and invertible (the only
+    known entries built for several channels), or None."""
+    if not known:
+        return None
+    if not isinstance(known, dict) or list(known) != [f"a{na}"]:
+        raise ValueError(f"known: for several inputs or outputs only the mean of the leading matrix is built, as "
+                         f"{{'a{na}': M}} with M real ny x ny; got {known!r}")
+    M = _array(known[f"a{na}"], "known")
+    if np.iscomplexobj(M) or M.shape != (ny, ny):
+        raise ValueError(f"known: a{na} must be a real {ny} x {ny} matrix (the mean of A_{na}), got shape {M.shape}")
+    M = M.astype(float)
+    check_finite(M, "known")
+    if np.linalg.cond(M) > 1e12:
+        raise ValueError(f"known: a{na} must be invertible (condition number {np.linalg.cond(M):.3g})")
+    return M
+
+
 def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None, method="wgtls",
                   known=None, tol=1e-10, max_iter=50, covariance="analytic") -> MimoIdentificationResult:
     """lptv.identify's route for several inputs or outputs (its docstring has the arguments)."""
@@ -109,15 +127,13 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         raise ValueError(f"method must be one of {MIMO_METHODS} for several inputs or outputs, got {method!r}")
     if not isinstance(covariance, str) or covariance not in ("analytic", "none"):
         raise ValueError(f"covariance must be 'analytic' or 'none' for several inputs or outputs, got {covariance!r}")
-    if known:
-        raise ValueError("known: known coefficients are not built yet for several inputs or outputs; the "
-                         "normalisation is A_na,0 = I (METHOD.md section 19)")
     na, nb = as_order(na, "na"), as_order(nb, "nb")
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=1)
     datas = _experiments(u, y, w0, ts)
     d0 = datas[0]
     ny, nu = d0.n_outputs, d0.n_inputs
+    lead = _known_leading(known, na, ny)
     ka_r = as_entry_counts(ka, na, ny, ny, "ka")
     kb_r = as_entry_counts(kb, nb, ny, nu, "kb")
     st = MimoStructure(na, nb, ka_r, kb_r, ny, nu, d0.w0, d0.ts)
@@ -131,23 +147,22 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     if n_eq < st.free.size:
         raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters")
     P = np.array([d.periods for d in datas])
+    noisy = any(np.max(np.abs(d.C)) > 0 for d in datas)
+    if noisy and ny > 1 and P.min() <= ny:
+        raise ValueError(f"u, y: P = {int(P.min())} periods give residue covariances of rank at most P - 1 < ny = "
+                         f"{ny} (complex Wishart, METHOD.md section 19): several outputs need P > ny periods")
     data, cst = core_data(datas, rows_list), core_structure(st)
     warns = []
     try:
-        xi, iters, converged, sv, noise_free = wgtls(data, cst, tol=tol, max_iter=max_iter,
-                                                     method="gtls" if method == "gtls" else "wgtls")
-        d = ny * ny
-        if sv.size > d and sv[d] < 1.5 * sv[d - 1]:
-            warns.append(f"the model is nearly unidentifiable: the generalised singular value {d + 1} is "
-                         f"{sv[d] / sv[d - 1]:.3g} times value {d} (harmonic counts or orders too high, or a "
-                         "common periodic left factor)")
-        cost_sml = None
-        F = None
-        if method == "sml" and not noise_free:
-            xi, cost_sml, F, iters, converged = sml(data, cst, xi, tol=tol, max_iter=max_iter)
-        res, Ce = residues(data, cst, xi)
+        xi, iters, converged, sv, noise_free, cost_sml, free_cov, res, Ce = fit(
+            data, cst, method, tol=tol, max_iter=max_iter, covariance=covariance == "analytic")
     except FitError as err:
         raise ValueError(f"u, y: {err}") from None
+    d = ny * ny
+    if sv.size > d and sv[d] < 1.5 * sv[d - 1]:
+        warns.append(f"the model is nearly unidentifiable: the generalised singular value {d + 1} is "
+                     f"{sv[d] / sv[d - 1]:.3g} times value {d} (harmonic counts or orders too high, or a "
+                     "common periodic left factor)")
     n_scalar = res.size
     if cost_sml is not None:
         cost = cost_sml / n_scalar
@@ -157,7 +172,7 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         q = np.real(np.einsum("rp,rp->r", res.conj(), np.linalg.solve(Ce, res[..., None])[..., 0]))
         cost = float(np.sum(q)) / n_scalar
     cov, factor = None, 1.0
-    if covariance == "analytic" and not noise_free:
+    if free_cov is not None:
         Pmin = int(P.min())
         # (P-1)/(P-3) for every ny, calibrated by Monte Carlo (METHOD.md section 19): the
         # (P-1)/(P-2-ny) of the Wishart argument over-covers at ny = 2 (97.7 % at P = 8)
@@ -166,14 +181,16 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         else:
             warns.append(f"the covariance is without its small-sample factor (P - 1) / (P - 3): P = {Pmin} "
                          "periods, at least 4 needed")
-        try:
-            free_cov = np.linalg.inv(F if F is not None else fisher(data, cst, xi)) if method == "sml" \
-                else sandwich(data, cst, xi)
-        except (np.linalg.LinAlgError, FitError) as err:
-            raise ValueError(f"u, y: the covariance cannot be formed: {err}") from None
         cov = factor * expand(free_cov, st)
     for msg in warns:
         warnings.warn(msg, UserWarning, stacklevel=3)
+    if lead is not None:
+        # the model with A_na,0 = M is M times the one with A_na,0 = I (the same system)
+        Kx = np.kron(lead, np.eye(st.n_row))
+        xi = Kx @ xi
+        cov = None if cov is None else Kx @ cov @ Kx.T
+        res = res @ lead.T
+        Ce = np.einsum("pi,rij,qj->rpq", lead, Ce, lead)
     a, b = st.coefficients(xi)
     model = MimoModel(a, b, w0=d0.w0, ts=d0.ts)
     row_P = np.concatenate([np.full(r.size, p) for r, p in zip(rows_list, P)])
@@ -256,7 +273,7 @@ def mimo_crb(model: MimoModel, inputs, *, noise, periods: int, lines=None, ka=No
         raise ValueError(f"noise must have shape ({c},), ({L1}, {c}) or ({L1}, {c}, {c}), got {Nz.shape}")
     check_finite(C, "noise")
     if np.any(np.real(np.diagonal(C, axis1=1, axis2=2)) < 0):
-        raise ValueError("noise: a variance is negative")
+        raise ValueError("noise must hold non-negative variances, got a negative one")
     from .fds import simulate
 
     ka = model.a.shape[3] // 2 if ka is None else ka

@@ -160,3 +160,25 @@ TEST_CASE("MIMO estimators refuse bad input", "[mimo_estimators]") {
   REQUIRE_THROWS_AS(lptv::mimo_wgtls(data, s, 1e-10, 10), std::invalid_argument);
   REQUIRE_THROWS_AS(lptv::mimo_sml(data, structure(), Eigen::VectorXd::Zero(3), 1e-10, 10), std::invalid_argument);
 }
+
+TEST_CASE("mimo_fit is WGTLS, SML and their covariances in one call", "[mimo_estimators]") {
+  const lptv::MimoModel m = two_by_two();
+  const auto data = experiments(m, 0.02, 5);
+  const lptv::MimoEstimate w = lptv::mimo_wgtls(data, structure(), 1e-10, 50);
+  const lptv::MimoEstimate s = lptv::mimo_sml(data, structure(), w.xi, 1e-10, 50);
+  const lptv::MimoFit fw = lptv::mimo_fit(data, structure(), "wgtls", 1e-10, 50, true);
+  const lptv::MimoFit fs = lptv::mimo_fit(data, structure(), "sml", 1e-10, 50, true);
+  REQUIRE(fw.estimate.xi == w.xi);  // the same operations on the same numbers
+  REQUIRE(fs.estimate.xi == s.xi);
+  const Eigen::MatrixXd sw = lptv::mimo_sandwich(data, structure(), w.xi);
+  REQUIRE((fw.covariance - sw).cwiseAbs().maxCoeff() <= 1e-12 * sw.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd I = fs.covariance * s.information;
+  REQUIRE((I - Eigen::MatrixXd::Identity(I.rows(), I.cols())).cwiseAbs().maxCoeff() <= 1e-8);
+  Eigen::MatrixXcd e, Ce;
+  lptv::mimo_residues(data[1], structure(), s.xi, e, Ce);
+  const Eigen::Index r0 = static_cast<Eigen::Index>(data[0].rows.size());
+  REQUIRE(fs.residues.rows() == r0 + e.rows());
+  REQUIRE((fs.residues.bottomRows(e.rows()) - e).cwiseAbs().maxCoeff() == 0.0);
+  REQUIRE((fs.residue_covariance.bottomRows(Ce.rows()) - Ce).cwiseAbs().maxCoeff() == 0.0);
+  REQUIRE_THROWS_AS(lptv::mimo_fit(data, structure(), "ls", 1e-10, 50, true), std::invalid_argument);
+}

@@ -4,6 +4,7 @@
 #pragma once
 #include <Eigen/Dense>
 #include <complex>
+#include <string>
 #include <vector>
 
 namespace lptv {
@@ -61,5 +62,19 @@ Eigen::MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoSt
 // 19.12 of one experiment at xi.
 void mimo_residues(const MimoSpectra& d, const MimoStructure& s, const Eigen::VectorXd& xi,
                    Eigen::MatrixXcd& e, Eigen::MatrixXcd& Ce);
+
+// One fit with the rows' terms formed once: WGTLS ("gtls": unweighted; "wgtls"), then SML
+// ("sml") from it; the covariance over the free entries (SML: the inverse Fisher information;
+// WGTLS: the first-order sandwich; empty without covariance or for noise-free data), without the
+// small-sample factor (P-1)/(P-3) that lptv.identify applies; the residues of all experiments'
+// rows (rows x ny) and their covariances ((rows ny) x ny).
+struct MimoFit {
+  MimoEstimate estimate;
+  Eigen::MatrixXd covariance;
+  Eigen::MatrixXcd residues;
+  Eigen::MatrixXcd residue_covariance;
+};
+MimoFit mimo_fit(const std::vector<MimoSpectra>& data, const MimoStructure& s, const std::string& method, double tol,
+                 int max_iter, bool covariance);
 
 }  // namespace lptv

@@ -148,7 +148,14 @@ def wgtls(st, experiments, tol=1e-10, max_iter=50):
             P = np.array([W @ g @ Cz for g in Gs])
             M = np.array(Gs)
             CJ += np.real(np.einsum("kaz,jaz->jk", P, M.conj()))
-        lam, V = scipy.linalg.eigh(H, 0.5 * (CJ + CJ.T))
+        CJ = 0.5 * (CJ + CJ.T)
+        try:
+            lam, V = scipy.linalg.eigh(H, CJ)
+        except np.linalg.LinAlgError:
+            # CJ singular (an input without noise): the pencil reversed, CJ v = mu H v with H
+            # positive definite; the smallest ratios are the largest mu (mu = 0: no noise)
+            mu, V = scipy.linalg.eigh(CJ, H)
+            V, lam = V[:, ::-1], 1.0 / mu[::-1]
         return _normalised(st, V[:, :d]), lam
 
     Ws = [np.eye(len(e[3]) * st.ny) for e in experiments]
