@@ -181,6 +181,25 @@ def test_the_fit_s_refusals_name_the_options(files, tmp_path, capsys):
     assert rc == 2 and "--method" in err and len(err.strip().splitlines()) == 1
 
 
+@needs_fit
+def test_noise_free_records_give_the_system_and_no_verdict(tmp_path, capsys):
+    """Identical periods (no noise): no statistics, so no verdict (exit status 4) and no std; the
+    estimate is the integrated system's (DOP853 at rtol 1e-11 and a Jacobian of modest condition:
+    1e-8 of the largest coefficient; measured 8e-12)."""
+    files = []
+    for e in range(2):
+        u1, y1 = steady_period(10 + e)
+        files.append(write_csv(tmp_path / f"e{e}.csv", np.tile(u1, (P, 1, 1)), np.tile(y1, (P, 1, 1))))
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
+    assert rc == 4, out + err
+    assert "verdict: no verdict" in out
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["model_ok"] is None and all(p["std"] is None for p in summary["parameters"])
+    values = np.array([p["value"] for p in summary["parameters"]])
+    truth = np.array([true_value(p["name"]) for p in summary["parameters"]])
+    assert np.abs(values - truth).max() <= 1e-8 * np.abs(truth).max()
+
+
 def test_without_the_mimo_fit_the_command_says_so(files, tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(mimoid, "mimo_fit_available", lambda: False)
     rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
