@@ -10,6 +10,7 @@
 
 #include "lptv/errors.hpp"
 #include "lptv/multisine.hpp"
+#include "floquet_detail.hpp"
 #include "monodromy.hpp"
 #include "rows.hpp"
 
@@ -95,15 +96,14 @@ struct HillEigen {
   Eigen::VectorXd rounding;  // eps ||H|| / rcond (LAPACK's error bound), times T0
 };
 
-HillEigen hill_eigen(const Eigen::MatrixXcd& C, int na, double w0, int M) {
-  const int KF = static_cast<int>(C.cols() - 1) / 2, n = na * (2 * M + 1);
+HillEigen hill_eigen(const std::vector<Eigen::MatrixXcd>& F, int na, double w0, int M) {
+  const int KF = static_cast<int>(F.size() - 1) / 2, n = na * (2 * M + 1);
   Eigen::MatrixXcd H = Eigen::MatrixXcd::Zero(n, n);
   for (int p = -M; p <= M; ++p) {
     const int row = (p + M) * na;
     for (int q = std::max(-M, p - KF); q <= std::min(M, p + KF); ++q) {
-      H.block(row + na - 1, (q + M) * na, 1, na) = C.col(KF + p - q).transpose();
+      H.block(row, (q + M) * na, na, na) = F[KF + p - q];
     }
-    for (int r = 0; r + 1 < na; ++r) H(row + r, row + r + 1) += 1.0;
     for (int r = 0; r < na; ++r) H(row + r, row + r) -= cd(0.0, p * w0);
   }
   HillEigen out;
@@ -261,17 +261,61 @@ Floquet finish(std::vector<cd> lam, std::vector<double> err, std::vector<cd> mu,
   return f;
 }
 
+// Companion form of the SISO model: the harmonics of F(t) as na x na blocks (ones on the
+// superdiagonal of harmonic 0, the last row from companion_harmonics).
+std::vector<Eigen::MatrixXcd> companion_blocks(const Model& m) {
+  const int na = m.na();
+  const Eigen::MatrixXcd C = companion_harmonics(m);
+  const int KF = static_cast<int>(C.cols() - 1) / 2;
+  std::vector<Eigen::MatrixXcd> F(2 * KF + 1, Eigen::MatrixXcd::Zero(na, na));
+  for (int k = -KF; k <= KF; ++k) F[KF + k].row(na - 1) = C.col(KF + k).transpose();
+  for (int r = 0; r + 1 < na; ++r) F[KF](r, r + 1) = 1.0;
+  return F;
+}
+
 Floquet floquet_ct(const Model& m, const FloquetOptions& opt) {
   detail::check_leading_ct(m);
-  const int na = m.na();
-  const double w0 = m.w0(), T0 = 2.0 * M_PI / w0;
-  if (na == 0) {
+  if (m.na() == 0) return detail::hill_floquet({}, m.w0(), opt);
+  return detail::hill_floquet(companion_blocks(m), m.w0(), opt);
+}
+
+// ------------------------------------------------------------------ discrete time
+Floquet floquet_dt(const Model& m) {
+  const int N = m.samples_per_period();
+  if (m.na() == 0) {
+    detail::dt_last_rows(m);
+    return detail::product_floquet(detail::DtProduct{Eigen::MatrixXd(0, 0), 0.0}, m.w0(), N * m.ts());
+  }
+  return detail::product_floquet(detail::dt_product(m), m.w0(), N * m.ts());
+}
+
+void check_options(const FloquetOptions& opt) {
+  if (!(std::isfinite(opt.tol) && opt.tol > 0)) {
+    throw std::invalid_argument("tol must be positive and finite, got " + std::to_string(opt.tol));
+  }
+  if (opt.min_truncation < 1) {
+    throw std::invalid_argument("min_truncation must be >= 1, got " + std::to_string(opt.min_truncation));
+  }
+  if (opt.max_truncation < opt.min_truncation) {
+    throw std::invalid_argument("max_truncation must be >= min_truncation (" +
+                                std::to_string(opt.min_truncation) + "), got " +
+                                std::to_string(opt.max_truncation));
+  }
+}
+
+}  // namespace
+
+namespace detail {
+
+Floquet hill_floquet(const std::vector<Eigen::MatrixXcd>& F, double w0, const FloquetOptions& opt) {
+  const double T0 = 2.0 * M_PI / w0;
+  if (F.empty() || F[0].rows() == 0) {
     Floquet f = finish({}, {}, {}, w0, true);
     f.method = "hill";
     return f;
   }
-  const Eigen::MatrixXcd C = companion_harmonics(m);
-  const int KF = static_cast<int>(C.cols() - 1) / 2;
+  const int na = static_cast<int>(F[0].rows());
+  const int KF = static_cast<int>(F.size() - 1) / 2;
   int M = std::max(opt.min_truncation, KF);
   if (M > opt.max_truncation) {
     std::ostringstream msg;
@@ -279,15 +323,15 @@ Floquet floquet_ct(const Model& m, const FloquetOptions& opt) {
         << ", more than max_truncation = " << opt.max_truncation;
     throw NumericalError(msg.str());
   }
-  const detail::SingleThreadedBlas single(true);  // dense work of a few hundred columns
+  const SingleThreadedBlas single(true);  // dense work of a few hundred columns
   std::vector<cd> prev;
   std::vector<double> prev_rounding;
   for (;;) {
-    const HillEigen h = hill_eigen(C, na, w0, M);
+    const HillEigen h = hill_eigen(F, na, w0, M);
     const std::vector<int> kept = select_family_representatives(h, na, w0);
     if (static_cast<int>(kept.size()) != na) {
       throw NumericalError("Hill's matrix at truncation M = " + std::to_string(M) +
-                           " has fewer distinct exponent families than na");
+                           " has fewer distinct exponent families than states");
     }
     std::vector<cd> cur(na);
     std::vector<double> rounding(na);
@@ -330,17 +374,13 @@ Floquet floquet_ct(const Model& m, const FloquetOptions& opt) {
   }
 }
 
-// ------------------------------------------------------------------ discrete time
-Floquet floquet_dt(const Model& m) {
-  const int na = m.na(), N = m.samples_per_period();
-  const double w0 = m.w0(), T0 = N * m.ts();
+Floquet product_floquet(const DtProduct& prod, double w0, double T0) {
+  const int na = static_cast<int>(prod.Phi.rows());
   if (na == 0) {
-    detail::dt_last_rows(m);
     Floquet f = finish({}, {}, {}, w0, false);
     f.method = "product";
     return f;
   }
-  const detail::DtProduct prod = detail::dt_product(m);
   Eigen::EigenSolver<Eigen::MatrixXd> es(prod.Phi, true);
   if (es.info() != Eigen::Success) throw NumericalError("eigenvalues of the monodromy matrix failed");
   const Eigen::VectorXcd mu = es.eigenvalues();
@@ -365,21 +405,9 @@ Floquet floquet_dt(const Model& m) {
   return f;
 }
 
-void check_options(const FloquetOptions& opt) {
-  if (!(std::isfinite(opt.tol) && opt.tol > 0)) {
-    throw std::invalid_argument("tol must be positive and finite, got " + std::to_string(opt.tol));
-  }
-  if (opt.min_truncation < 1) {
-    throw std::invalid_argument("min_truncation must be >= 1, got " + std::to_string(opt.min_truncation));
-  }
-  if (opt.max_truncation < opt.min_truncation) {
-    throw std::invalid_argument("max_truncation must be >= min_truncation (" +
-                                std::to_string(opt.min_truncation) + "), got " +
-                                std::to_string(opt.max_truncation));
-  }
-}
+void check_floquet_options(const FloquetOptions& opt) { check_options(opt); }
 
-}  // namespace
+}  // namespace detail
 
 Floquet floquet(const Model& m, const FloquetOptions& opt) {
   check_options(opt);

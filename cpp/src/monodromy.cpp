@@ -60,27 +60,31 @@ DtProduct dt_product(const Model& m) {
   const int na = m.na();
   const Eigen::MatrixXd rows = dt_last_rows(m);
   const int N = static_cast<int>(rows.rows());
-  auto step = [&](int k) {
-    Eigen::MatrixXd Ck = Eigen::MatrixXd::Zero(na, na);
-    for (int r = 0; r + 1 < na; ++r) Ck(r, r + 1) = 1.0;
-    Ck.row(na - 1) = rows.row(k);
-    return Ck;
-  };
-  // Forward products P_k = C_{k-1}..C_0 and backward S_k = C_{N-1}..C_k: rounding in step k
-  // (na eps |C_k| |P_k| at most) reaches Phi through S_{k+1}.
+  std::vector<Eigen::MatrixXd> G(N, Eigen::MatrixXd::Zero(na, na));
+  for (int k = 0; k < N; ++k) {
+    for (int r = 0; r + 1 < na; ++r) G[k](r, r + 1) = 1.0;
+    G[k].row(na - 1) = rows.row(k);
+  }
+  return product_of_steps(G);
+}
+
+DtProduct product_of_steps(const std::vector<Eigen::MatrixXd>& G) {
+  const int N = static_cast<int>(G.size());
+  const Eigen::Index na = N ? G[0].rows() : 0;
+  // Forward products P_k = G_{k-1}..G_0 and backward S_k = G_{N-1}..G_k: rounding in step k
+  // (na eps |G_k| |P_k| at most) reaches Phi through S_{k+1}.
   std::vector<double> before(N), after(N + 1);
   Eigen::MatrixXd P = Eigen::MatrixXd::Identity(na, na);
   for (int k = 0; k < N; ++k) {
     before[k] = P.norm();
-    P = step(k) * P;
+    P = G[k] * P;
   }
   Eigen::MatrixXd S = Eigen::MatrixXd::Identity(na, na);
   after[N] = S.norm();
   DtProduct out;
   for (int k = N - 1; k >= 0; --k) {
-    const Eigen::MatrixXd Ck = step(k);
-    out.error += na * std::numeric_limits<double>::epsilon() * after[k + 1] * Ck.norm() * before[k];
-    S = S * Ck;
+    out.error += na * std::numeric_limits<double>::epsilon() * after[k + 1] * G[k].norm() * before[k];
+    S = S * G[k];
     after[k] = S.norm();
   }
   out.Phi = P;

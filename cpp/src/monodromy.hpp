@@ -1,6 +1,7 @@
 // Private helpers shared by floquet.cpp (Hill's method) and monodromy.cpp (the product routes).
 #pragma once
 #include <Eigen/Dense>
+#include <vector>
 
 #include "lptv/model.hpp"
 
@@ -21,6 +22,9 @@ struct DtProduct {
   double error = 0;
 };
 DtProduct dt_product(const Model& m);
+
+// The same for any one-step matrices: Phi = G_{N-1} ... G_0 with its rounding bound.
+DtProduct product_of_steps(const std::vector<Eigen::MatrixXd>& G);
 
 }  // namespace detail
 }  // namespace lptv

@@ -21,6 +21,22 @@ void bind_floquet(py::module_& m) {
     return lptv::floquet(model, opt);
   }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
         "Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).");
+  m.def("floquet_mimo", [](const lptv::MimoModel& model, double tol, int min_truncation, int max_truncation) {
+    lptv::FloquetOptions opt;
+    opt.tol = tol;
+    opt.min_truncation = min_truncation;
+    opt.max_truncation = max_truncation;
+    py::gil_scoped_release release;  // the eigenvalue problems are C++ only
+    return lptv::floquet(model, opt);
+  }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
+        "Multipliers and exponents of the matrix system (see lptv.floquet for the documented API).");
+  m.def("monodromy_mimo", py::overload_cast<const lptv::MimoModel&, int>(&lptv::monodromy), "model"_a, "steps"_a,
+        py::call_guard<py::gil_scoped_release>(),
+        "Monodromy matrix of the matrix system's state form by products (Magnus steps and Richardson, or the\n"
+        "one-step matrices in discrete time).");
+  m.def("mimo_row_degrees", &lptv::row_degrees, "model"_a, "The row degrees d_p of A(t, s).");
+  m.def("mimo_state_matrix", &lptv::state_matrix_at, "model"_a, "t"_a,
+        "The state (one-step) matrix of the matrix system's observer form at time t.");
   py::class_<lptv::ProductRadius>(m, "ProductRadius",
                                   "The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).")
       .def_readonly("settled", &lptv::ProductRadius::settled)
@@ -31,7 +47,7 @@ void bind_floquet(py::module_& m) {
         py::call_guard<py::gil_scoped_release>(),
         "Monodromy products with first_steps, 2 first_steps, ... steps until two successive spectral radii\n"
         "differ by less than a tenth of their distance to 1 (lptv.floquet.stability_check's first route).");
-  m.def("monodromy", &lptv::monodromy, "model"_a, "steps"_a, py::call_guard<py::gil_scoped_release>(),
+  m.def("monodromy", py::overload_cast<const lptv::Model&, int>(&lptv::monodromy), "model"_a, "steps"_a, py::call_guard<py::gil_scoped_release>(),
         "Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps\n"
         "and Richardson) or of the one-step companion matrices (discrete time).");
 }

@@ -26,6 +26,6 @@ PYBIND11_MODULE(_core, m) {
   bind_distortion(m);
   bind_moderation(m);
   bind_record(m);
+  bind_mimo(m);     // before floquet: its MimoModel is an argument type of floquet_mimo
   bind_floquet(m);
-  bind_mimo(m);
 }

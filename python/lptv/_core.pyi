@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_sandwich', 'mimo_sml', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -537,53 +537,6 @@ class RecordFit:
     @property
     def transient_std(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
-class Floquet:
-    """
-    Characteristic multipliers and Floquet exponents (lptv::floquet).
-    """
-    @property
-    def convergence(self) -> float:
-        ...
-    @property
-    def error_estimate(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def exponents(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
-        ...
-    @property
-    def harmonics(self) -> int:
-        ...
-    @property
-    def is_stable(self) -> bool:
-        ...
-    @property
-    def method(self) -> str:
-        ...
-    @property
-    def multipliers(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
-        ...
-    @property
-    def spectral_radius(self) -> float:
-        ...
-    @property
-    def truncation(self) -> int:
-        ...
-class ProductRadius:
-    """
-    The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).
-    """
-    @property
-    def reason(self) -> str:
-        ...
-    @property
-    def rho(self) -> float:
-        ...
-    @property
-    def settled(self) -> bool:
-        ...
-    @property
-    def steps(self) -> int:
-        ...
 class MimoModel:
     """
     Validated matrix LPTV model (see lptv.MimoModel for the documented API).
@@ -683,6 +636,53 @@ class MimoFit:
     @property
     def residues(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
         ...
+class Floquet:
+    """
+    Characteristic multipliers and Floquet exponents (lptv::floquet).
+    """
+    @property
+    def convergence(self) -> float:
+        ...
+    @property
+    def error_estimate(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def exponents(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def harmonics(self) -> int:
+        ...
+    @property
+    def is_stable(self) -> bool:
+        ...
+    @property
+    def method(self) -> str:
+        ...
+    @property
+    def multipliers(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
+        ...
+    @property
+    def spectral_radius(self) -> float:
+        ...
+    @property
+    def truncation(self) -> int:
+        ...
+class ProductRadius:
+    """
+    The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).
+    """
+    @property
+    def reason(self) -> str:
+        ...
+    @property
+    def rho(self) -> float:
+        ...
+    @property
+    def settled(self) -> bool:
+        ...
+    @property
+    def steps(self) -> int:
+        ...
 def band_matrix(model: Model, L: typing.SupportsInt | typing.SupportsIndex, a: bool = True) -> scipy.sparse.csc_matrix:
     ...
 def column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -780,6 +780,10 @@ def floquet(model: Model, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-
     """
     Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).
     """
+def floquet_mimo(model: MimoModel, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-11, min_truncation: typing.SupportsInt | typing.SupportsIndex = 8, max_truncation: typing.SupportsInt | typing.SupportsIndex = 256) -> Floquet:
+    """
+    Multipliers and exponents of the matrix system (see lptv.floquet for the documented API).
+    """
 def gsvd_pairs(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], int]:
     ...
 def htf(model: Model, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
@@ -821,6 +825,10 @@ def mimo_residues(data: tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.com
     """
     (residues rows x ny, their covariances (rows ny) x ny) of one experiment
     """
+def mimo_row_degrees(model: MimoModel) -> list[int]:
+    """
+    The row degrees d_p of A(t, s).
+    """
 def mimo_sandwich(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     """
     WGTLS's first-order sandwich covariance
@@ -828,6 +836,10 @@ def mimo_sandwich(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.ty
 def mimo_sml(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, xi0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex) -> MimoEstimate:
     """
     Levenberg-Marquardt on the rows' exact likelihood from xi0
+    """
+def mimo_state_matrix(model: MimoModel, t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    The state (one-step) matrix of the matrix system's observer form at time t.
     """
 def mimo_wgtls(data: collections.abc.Sequence[tuple[typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]]], structure: MimoStructure, tol: typing.SupportsFloat | typing.SupportsIndex, max_iter: typing.SupportsInt | typing.SupportsIndex, weighted: bool = True) -> MimoEstimate:
     """
@@ -854,6 +866,11 @@ def monodromy(model: Model, steps: typing.SupportsInt | typing.SupportsIndex) ->
     """
     Monodromy matrix by the product of matrix exponentials (continuous time, `steps` Magnus steps
     and Richardson) or of the one-step companion matrices (discrete time).
+    """
+def monodromy_mimo(model: MimoModel, steps: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    Monodromy matrix of the matrix system's state form by products (Magnus steps and Richardson, or the
+    one-step matrices in discrete time).
     """
 def multisine_spectrum(lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], phases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], n_samples: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"]:
     ...

@@ -39,11 +39,10 @@ def channel_name(x, role):
     word, kw, opt = ROLES[role]
     if x is None:
         return None
-    if role == "y" and isinstance(x, (list, tuple)):
-        if len(x) == 1:
-            x = x[0]
-        elif len(x) > 1 and all(isinstance(v, str) for v in x):
-            raise FileError(one_output_message(list(x)))
+    if isinstance(x, (list, tuple)) and len(x) == 1 and role != "time":
+        x = x[0]      # a list of one channel: the one-channel reader (several: several_channels)
+    if role == "y" and isinstance(x, (list, tuple)) and len(x) > 1 and all(isinstance(v, str) for v in x):
+        raise FileError(one_output_message(list(x)))
     if not isinstance(x, str) or not x.strip():
         raise FileError(f"{kw} ({opt}) must name a channel of the file (a non-empty str), got {x!r}")
     return x.strip()
@@ -179,3 +178,59 @@ def listing(shapes: Dict[str, Optional[tuple]]) -> str:
         return "the file has none"
     parts = [k if s is None else f"{k} ({' x '.join(map(str, s)) or 'scalar'})" for k, s in shapes.items()]
     return "the file has " + ", ".join(parts)
+
+
+# ------------------------------------------------------------------------- several channels
+
+def several_channels(u, y) -> Optional[Tuple[Tuple[str, ...], Tuple[str, ...]]]:
+    """(inputs, outputs) as tuples of names when ``u`` or ``y`` is a list or tuple of two or
+    more names (several inputs or outputs, METHOD.md section 19), else None (one of each: the
+    SISO reader's arguments, a list of one name included). FileError for an empty list, a name
+    that is not a non-empty str, or a channel named twice."""
+    lists = [isinstance(x, (list, tuple)) for x in (u, y)]
+    if not any(isinstance(x, (list, tuple)) and len(x) > 1 for x in (u, y)):
+        return None
+    out = []
+    seen = {}
+    for x, role, is_list in zip((u, y), ("u", "y"), lists):
+        word, kw, opt = ROLES[role]
+        names = list(x) if is_list else [x if x is not None else role]
+        if not names:
+            raise FileError(f"{kw} ({opt}) must name at least one {word} channel, got an empty list")
+        for n in names:
+            if not isinstance(n, str) or not n.strip():
+                raise FileError(f"{kw} ({opt}) must name channels of the file (non-empty str), got {n!r}")
+            key = n.strip().lower()
+            if key in seen:
+                raise FileError(f"channel '{n.strip()}' is named twice ({seen[key]} and {opt} ({kw})): a "
+                                "channel must be read once")
+            seen[key] = f"{opt} ({kw})"
+        out.append(tuple(n.strip() for n in names))
+    return out[0], out[1]
+
+
+def read_several(read_one, path, inputs, outputs, options: dict):
+    """Several inputs and outputs: ``read_one`` (:func:`lptv.read_measurements`) on pairs of one
+    input and one output, so that every channel is matched, split into periods, trimmed and
+    checked as the SISO reader does; the channels stacked on a last axis: u (P, N, nu) and y
+    (P, N, ny). The Measurements' ``input`` and ``output`` are the tuples of the file's names."""
+    import dataclasses
+
+    if options.get("realisations"):
+        raise FileError("realisations=True reads one input and one output; several channels "
+                        f"({len(inputs)} inputs, {len(outputs)} outputs) are read as periods only")
+    options = {k: v for k, v in options.items() if k != "realisations"}
+    reads = []
+    for i in range(max(len(inputs), len(outputs))):
+        reads.append(read_one(path, u=inputs[min(i, len(inputs) - 1)], y=outputs[min(i, len(outputs) - 1)],
+                              **options))
+    first = reads[0]
+    for m in reads[1:]:
+        if m.u.shape != first.u.shape or m.trimmed != first.trimmed:   # the same options on one file
+            raise FileError(f"channels '{m.input}' and '{first.input}' differ in shape: "
+                            f"{' x '.join(map(str, m.u.shape))} against {' x '.join(map(str, first.u.shape))}")
+    u = np.stack([reads[min(i, len(reads) - 1)].u for i in range(len(inputs))], axis=-1)
+    y = np.stack([reads[min(i, len(reads) - 1)].y for i in range(len(outputs))], axis=-1)
+    names_u = tuple(reads[min(i, len(reads) - 1)].input for i in range(len(inputs)))
+    names_y = tuple(reads[min(i, len(reads) - 1)].output for i in range(len(outputs)))
+    return dataclasses.replace(first, u=u, y=y, input=names_u, output=names_y)

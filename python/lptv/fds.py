@@ -41,8 +41,8 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
         ``U[l] = A/2 exp(j phi)``. ``U[0]`` must be real. Several columns share one factorisation.
         For an :class:`lptv.MimoModel` with nu inputs and ny outputs: shape (L+1, nu), giving
         (lines, ny), or (L+1, nu, E) for E experiments sharing one factorisation, giving
-        (lines, ny, E) (METHOD.md section 18: the block band system, channel fastest); the
-        stability check is not made for it (no Floquet analysis of matrix models yet).
+        (lines, ny, E) (METHOD.md section 19: the block band system, channel fastest); the
+        stability check is :func:`lptv.floquet`'s on the matrix system.
     lines_out : int, optional
         Highest output line to return (default L).
     guard : int, optional
@@ -95,8 +95,11 @@ def simulate(model: Model, U, *, lines_out: Optional[int] = None, guard: Optiona
     if isinstance(model, MimoModel):
         from .mimo_fds import simulate_mimo
 
-        return simulate_mimo(model, U, lines_out=lines_out, guard=guard, tol=tol, max_guard=max_guard,
-                             solver=solver, full_output=full_output)
+        out = simulate_mimo(model, U, lines_out=lines_out, guard=guard, tol=tol, max_guard=max_guard,
+                            solver=solver, full_output=full_output)
+        if as_bool(warn_unstable, "warn_unstable"):
+            _warn_unstable(model)
+        return out
     _check_model(model)
     Ua, was_1d = as_spectrum(U, "U")
     lines_out = -1 if lines_out is None else as_int(lines_out, "lines_out")

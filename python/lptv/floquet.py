@@ -8,6 +8,7 @@ import numpy as np
 
 from . import _core
 from ._validate import as_int, as_positive_float
+from .mimo import MimoModel
 from .model import Model
 
 __all__ = ["FloquetResult", "UnstableModelWarning", "floquet", "monodromy", "stability_check",
@@ -56,13 +57,16 @@ class FloquetResult:
     """T0 = 2 pi / w0 in seconds."""
 
 
-def _check_model(model):
+def _check_model(model, mimo=False):
+    if mimo and isinstance(model, MimoModel):
+        return model
     if not isinstance(model, Model):
-        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+        kinds = "an lptv.Model or lptv.MimoModel" if mimo else "an lptv.Model"
+        raise ValueError(f"model must be {kinds}, got {type(model).__name__}")
     return model
 
 
-def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
+def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
             max_truncation: int = 256) -> FloquetResult:
     """Characteristic multipliers and Floquet exponents of ``model``: is it stable?
 
@@ -92,11 +96,19 @@ def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
     stabilised experiment, or simulation), it identifies an unstable system as it does a stable
     one, and does not say so. Check ``lptv.floquet(res.model).is_stable``.
 
+    Several outputs (an :class:`lptv.MimoModel`, METHOD.md section 19): the homogeneous
+    equation ``sum_n A_n(t) d^n y/dt^n = 0`` with A(t, s) row-reduced (row degrees d_p, the
+    highest order in row p; the matrix L(t) of row p's coefficients of order d_p invertible over
+    the period; equal degrees: A_na(t) invertible, as the mass matrix of M y'' + C y' + K(t) y).
+    Its state (the observer form, of dimension sum_p d_p) has sum_p d_p multipliers, computed as
+    above: Hill's method in continuous time, the product of the N one-step matrices in discrete
+    time. A 1 x 1 model gives the multipliers of the SISO model.
+
     Parameters
     ----------
-    model : lptv.Model
-        a_na(t) must not vanish over the period (continuous time: checked on a fine grid;
-        discrete time: at the N samples).
+    model : lptv.Model or lptv.MimoModel
+        a_na(t) (several outputs: L(t)) must not vanish (be singular) over the period
+        (continuous time: checked on a fine grid; discrete time: at the N samples).
     tol : float
         Continuous time: convergence tolerance of the truncation on ln(mu_i).
     min_truncation, max_truncation : int
@@ -132,13 +144,27 @@ def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
     (False, array([-1.0158, -0.8682]))
     >>> lptv.floquet(mathieu_model(zeta=0.02, wn=1.0, eps=0.06, w0=2.0)).is_stable
     True
+
+    Two masses coupled by a spring k_c(t) = 1 + 0.9 cos(w0 t) (k_1 = k_2 = 1, M = I): the
+    modes are at 1 and sqrt(3) rad/s, and the spring pumps the second one; at w0 = 2 sqrt(3)
+    (its parametric resonance) the system is unstable though every frozen pole is damped.
+
+    >>> kc = np.array([0.45, 1.0, 0.45])                     # harmonics -1, 0, 1 of k_c(t)
+    >>> S = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    >>> K = S[:, :, None] * kc
+    >>> K[:, :, 1] += np.eye(2)                              # k_1 = k_2 = 1
+    >>> two = lptv.MimoModel.mechanical(np.eye(2), 0.01 * np.eye(2), K, np.eye(2), w0=2 * 3 ** 0.5)
+    >>> f = lptv.floquet(two)
+    >>> f.multipliers.size, f.is_stable
+    (4, False)
     """
-    _check_model(model)
+    _check_model(model, mimo=True)
     tol = as_positive_float(tol, "tol")
     min_truncation = as_int(min_truncation, "min_truncation", minimum=1)
     max_truncation = as_int(max_truncation, "max_truncation", minimum=1)
-    r = _core.floquet(model._cpp, tol=tol, min_truncation=min_truncation,
-                      max_truncation=max_truncation)
+    route = _core.floquet_mimo if isinstance(model, MimoModel) else _core.floquet
+    r = route(model._cpp, tol=tol, min_truncation=min_truncation,
+              max_truncation=max_truncation)
     return FloquetResult(
         multipliers=np.asarray(r.multipliers), exponents=np.asarray(r.exponents),
         is_stable=bool(r.is_stable), spectral_radius=float(r.spectral_radius),
@@ -147,8 +173,12 @@ def floquet(model: Model, *, tol: float = 1e-11, min_truncation: int = 8,
         period=model.period if not model.discrete else model.samples_per_period * model.ts)
 
 
-def monodromy(model: Model, steps: Optional[int] = 2000) -> np.ndarray:
+def monodromy(model, steps: Optional[int] = 2000) -> np.ndarray:
     """The monodromy matrix Phi (na x na) by a route independent of Hill's method, for checks.
+
+    An :class:`lptv.MimoModel` gives the monodromy matrix of its state form (the observer form
+    of METHOD.md section 19, sum_p d_p square) by the same products; its eigenvalues are the
+    multipliers of :func:`floquet`.
 
     Continuous time: the product of the matrix exponentials of a fourth-order Magnus step over
     ``steps`` equal sub-intervals of one period (F(t) evaluated from the coefficients at the two
@@ -165,9 +195,10 @@ def monodromy(model: Model, steps: Optional[int] = 2000) -> np.ndarray:
     >>> bool(np.isclose(monodromy(m)[0, 0], np.exp(-4 * np.pi), rtol=1e-12))
     True
     """
-    _check_model(model)
+    _check_model(model, mimo=True)
     steps = 0 if model.discrete else as_int(steps, "steps", minimum=1)
-    return np.asarray(_core.monodromy(model._cpp, steps))
+    route = _core.monodromy_mimo if isinstance(model, MimoModel) else _core.monodromy
+    return np.asarray(route(model._cpp, steps))
 
 
 # The stability check of simulate and identify runs on every estimate, including over-fitted,
@@ -179,12 +210,13 @@ CHECK_MAX_STEPS = 4096
 CHECK_MAX_HILL = 400
 
 
-def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
+def stability_check(model) -> Tuple[Optional[str], Optional[str]]:
     """``(unstable, undecided)``: a sentence when ``model`` is unstable beyond its multipliers'
     error (else None), and a sentence when the check could not decide within its cost bound
     (else None); at most one of the two is set.
 
-    LTI models: the roots of a(s) (a(z)). LPTV models: the monodromy matrix by products
+    LTI models: the roots of a(s) (a(z)). A :class:`lptv.MimoModel`: the products below on its
+    state form (:func:`monodromy`), then :func:`floquet` as below. LPTV models: the monodromy matrix by products
     (:func:`monodromy` with 32, 64, ... up to ``CHECK_MAX_STEPS`` steps, until two successive
     spectral radii differ by less than a tenth of their distance to 1: under a millisecond on
     the paper's model), then :func:`floquet` with Hill's matrix at most ``CHECK_MAX_HILL`` rows.
@@ -212,7 +244,9 @@ def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
         return cached[1]
     undecided = None
     try:
-        if model.is_lti:
+        if isinstance(model, MimoModel):
+            text, undecided = _mimo_stability(model)
+        elif model.is_lti:
             text = _lti_unstable_text(model)
         else:
             text, undecided = _lptv_stability(model)
@@ -223,6 +257,43 @@ def stability_check(model: Model) -> Tuple[Optional[str], Optional[str]]:
                  "from rest never settles into it")
     model.__dict__["_stability"] = (model._cpp, (text, undecided))
     return text, undecided
+
+
+def _mimo_stability(model: MimoModel) -> Tuple[Optional[str], Optional[str]]:
+    # As for one output: the products first (the monodromy of the observer form with 32, 64, ...
+    # CHECK_MAX_STEPS Magnus steps until two spectral radii differ by less than a tenth of their
+    # distance to 1; discrete time the one exact product), then Hill's method with its matrix at
+    # most CHECK_MAX_HILL rows (the state has sum_p d_p components).
+    prev = None
+    for steps in ([0] if model.discrete else [32 * 2 ** i for i in range(int(np.log2(CHECK_MAX_STEPS // 32)) + 1)]):
+        try:
+            Phi = np.asarray(_core.monodromy_mimo(model._cpp, steps))
+        except _core.NumericalError:
+            prev = None
+            continue
+        rho = float(np.abs(np.linalg.eigvals(Phi)).max()) if Phi.size else 0.0
+        if not np.isfinite(rho):
+            prev = None
+            continue
+        if (model.discrete and rho != 1.0) or (prev is not None and abs(rho - prev) < 0.1 * abs(rho - 1.0)):
+            if rho > 1.0:
+                return f"the model is unstable (Floquet multiplier of magnitude {rho:.6g} > 1)", None
+            return None, None
+        prev = rho
+    n = int(sum(_core.mimo_row_degrees(model._cpp)))
+    try:
+        f = floquet(model, max_truncation=max(1, (CHECK_MAX_HILL // max(n, 1) - 1) // 2))
+    except _core.NumericalError as err:
+        return None, (f"stability not decided within the check's cost bound: Hill's method did not "
+                      f"converge ({err}); lptv.floquet(model, max_truncation=...) can try harder")
+    if f.multipliers.size == 0:
+        return None, None
+    k = int(np.argmax(np.abs(f.multipliers)))
+    mu, err = abs(f.multipliers[k]), f.error_estimate[k]
+    if mu > 1.0 and (mu - 1.0) > err * max(mu, 1.0):
+        return (f"the model is unstable (Floquet multiplier of magnitude {mu:.6g} > 1, "
+                f"Floquet exponent with real part {f.exponents[k].real:.6g} 1/s)"), None
+    return None, None
 
 
 def unstable_warning_text(model: Model) -> Optional[str]:

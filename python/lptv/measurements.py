@@ -35,7 +35,7 @@ import numpy as np
 from ._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
 from .recordcheck import RecordCheck, RecordWarning, check_record, detrended  # noqa: F401 - lptv.measurements.*
 from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, find, fs_from_time, listing,
-                       stored_fs, time_unit)
+                       read_several, several_channels, stored_fs, time_unit)
 
 FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
 _MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
@@ -66,9 +66,9 @@ class Measurements:
     skipped: int = 0
     """Whole periods dropped at the start (``skip_periods``)."""
     input: str = "u"
-    """The file's name of the input channel (column, array or variable)."""
+    """The file's name of the input channel (column, array or variable); several inputs: a tuple."""
     output: str = "y"
-    """The file's name of the output channel."""
+    """The file's name of the output channel; several outputs: a tuple."""
     fs_source: Optional[str] = None
     """Where fs came from: None when given (or unknown), else e.g. "column 'time'" or "variable 'fs'"."""
 
@@ -123,10 +123,12 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         error that says how many samples to drop.
     skip_periods : int
         Drop this many whole periods at the start (a start-up transient).
-    u, y : str, optional
+    u, y : str or list of str, optional
         The names of the input and output channels: CSV columns (matched up to case), NPZ
-        arrays or MAT variables (default ``'u'`` and ``'y'``). One output at a time: MIMO
-        models are not supported yet.
+        arrays or MAT variables (default ``'u'`` and ``'y'``). Several inputs or outputs
+        (METHOD.md section 19): a list of names, e.g. ``u=["f1", "f2"], y=["x1", "x2"]``; then
+        ``u`` of the result has shape (P, N, nu) and ``y`` (P, N, ny), and ``input`` and
+        ``output`` are tuples of the file's names (one name, or a list of one, stays 2-D).
     time : str, optional
         The name of a time column or variable in s (default: one named ``t`` or ``time``,
         also with a unit, ``time [s]``, ``t_ms``).
@@ -162,6 +164,11 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     >>> m.u.shape, m.fs, m.fs_source, m.input
     ((10, 100), 100.0, "column 'time'", 'force')
     """
+    several = several_channels(u, y)
+    if several is not None:
+        return read_several(read_measurements, path, *several, dict(
+            periods=periods, fs=fs, dt=dt, period=period, trim=trim, skip_periods=skip_periods, time=time,
+            realisations=realisations, detrend=detrend))
     path = Path(as_path(path))
     o = read_options(periods=periods, fs=fs, dt=dt, period=period, trim=trim, skip_periods=skip_periods,
                      u=u, y=y, time=time, detrend=detrend)

@@ -5,6 +5,7 @@ import numpy as np
 
 from . import _core
 from ._validate import as_int, as_lines, as_real_1d
+from .mimo import MimoModel
 from .model import Model
 
 
@@ -75,22 +76,81 @@ def _frozen_roots(coef_at, t, order, what):
     return out
 
 
-def frozen_poles(model: Model, t) -> np.ndarray:
+def frozen_poles(model, t) -> np.ndarray:
     """Roots of sum_n a_n(t) s^n (z^n in discrete time) at each t: array (len(t), na).
 
-    They say nothing about the stability of the time-varying system. Where a_na(t)
-    vanishes a pole goes to infinity (reported as inf).
+    They say nothing about the stability of the time-varying system (:func:`lptv.floquet`
+    does). Where a_na(t) vanishes a pole goes to infinity (reported as inf).
+
+    For an :class:`lptv.MimoModel` (METHOD.md section 19): the roots of
+    det sum_n A_n(t) s^n, sum_p d_p of them (d_p the row degrees, the highest order in row p
+    of A), as the eigenvalues of the frozen observer-form state matrix S - R L^{-1} E1 (the
+    block companion matrix when every row has degree na). Where the leading row coefficient
+    matrix L(t) is singular, poles go to infinity (inf, sorted first as for one output).
 
     Examples
     --------
-    >>> import lptv
+    >>> import numpy as np, lptv
     >>> m = lptv.Model([[1.0], [1.0], [1.0]], [[1.0]], w0=1.0)
     >>> lptv.frozen_poles(m, [0.0]).round(3)
     array([[-0.5-0.866j, -0.5+0.866j]])
+
+    Two masses with M = I, C = 0.2 I and K = [[2, -1], [-1, 2]]: det(M s^2 + C s + K) has the
+    roots of s^2 + 0.2 s + 1 and s^2 + 0.2 s + 3.
+
+    >>> mm = lptv.MimoModel.mechanical(np.eye(2), 0.2 * np.eye(2), [[2.0, -1.0], [-1.0, 2.0]],
+    ...                                np.eye(2), w0=1.0)
+    >>> p = lptv.frozen_poles(mm, [0.0])[0]
+    >>> p.real.round(3), np.sort(p.imag).round(3)
+    (array([-0.1, -0.1, -0.1, -0.1]), array([-1.729, -0.995,  0.995,  1.729]))
     """
+    if isinstance(model, MimoModel):
+        return _frozen_poles_mimo(model, as_real_1d(t, "t"))
     if not isinstance(model, Model):
-        raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")
+        raise ValueError(f"model must be an lptv.Model or lptv.MimoModel, got {type(model).__name__}")
     return _frozen_roots(model.a_at, t, model.na, "poles")
+
+
+def _frozen_poles_mimo(model: MimoModel, t: np.ndarray) -> np.ndarray:
+    ny = model.n_outputs
+    d = model.na_entries.max(axis=1)  # row degrees; -1: a zero row
+    if np.any(d < 0):
+        raise ValueError(f"model: row {int(np.argmax(d < 0))} of A(t, s) is zero at every order (det A(t, s) "
+                         "vanishes identically); every row must hold a nonzero coefficient")
+    off = np.concatenate([[0], np.cumsum(d)])
+    n = int(off[-1])
+    out = np.full((t.size, n), complex(np.inf, 0.0))
+    A = model.a_at(t)  # (len t, na+1, ny, ny)
+    E1 = np.zeros((ny, n))
+    for p in range(ny):
+        if d[p] > 0:
+            E1[p, off[p]] = 1.0
+    for i in range(t.size):
+        L = np.array([A[i, d[p], p, :] for p in range(ny)])
+        # frozen: the right-form coefficients are the A_n themselves; state rows w_{p,1..d_p}
+        S = np.zeros((n, n))
+        R = np.zeros((n, ny))
+        for p in range(ny):
+            for j in range(1, d[p] + 1):
+                r = off[p] + j - 1
+                if j < d[p]:
+                    S[r, r + 1] = 1.0
+                R[r] = A[i, d[p] - j, p, :]
+        sv = np.linalg.svd(L, compute_uv=False)
+        if sv[-1] > 1e-12 * max(sv[0], np.abs(A[i]).max()):
+            roots = np.linalg.eigvals(S - R @ np.linalg.solve(L, E1))
+        else:  # the pencil of [[S, -R], [E1, -L]] and diag(I, 0): the lost poles are infinite
+            from scipy.linalg import eigvals
+
+            Fd = np.block([[S, -R], [E1, -L]])
+            Ed = np.zeros((n + ny, n + ny))
+            Ed[:n, :n] = np.eye(n)
+            roots = eigvals(Fd, Ed)
+            roots = roots[np.isfinite(roots)]
+            roots = roots[np.argsort(np.abs(roots))[:n]]
+        roots = np.sort_complex(roots)
+        out[i, n - roots.size:] = roots
+    return out
 
 
 def frozen_zeros(model: Model, t) -> np.ndarray:

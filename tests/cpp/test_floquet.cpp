@@ -197,3 +197,73 @@ TEST_CASE("product_spectral_radius: the radii of monodromy(m, s) for doubling s,
   REQUIRE_THROWS_AS(lptv::product_spectral_radius(paper_model(), 0, 64), std::invalid_argument);
   REQUIRE_THROWS_AS(lptv::product_spectral_radius(paper_model(), 64, 32), std::invalid_argument);
 }
+
+TEST_CASE("several outputs: decoupled LTI rows give each row's exp(p T0); rows of different degrees", "[floquet][mimo]") {
+  // diag(s^2 + 0.4 s + 9.04, s + 1.5) with a coupling that is zero: the poles -0.2 +- 3j and
+  // -1.5; then the same with a first-order second row coupled through A_0 (triangular: the
+  // poles stay those of the diagonal).
+  const double w0 = 0.5, T0 = 2 * M_PI / w0;
+  Eigen::MatrixXcd a = Eigen::MatrixXcd::Zero(3 * 4, 1), b = Eigen::MatrixXcd::Ones(2, 1);
+  // row (n ny + p) ny + q
+  a(0 * 4 + 0, 0) = 9.04;  // A_0[0, 0]
+  a(0 * 4 + 3, 0) = 1.5;   // A_0[1, 1]
+  a(1 * 4 + 0, 0) = 0.4;   // A_1[0, 0]
+  a(1 * 4 + 3, 0) = 1.0;   // A_1[1, 1]
+  a(2 * 4 + 0, 0) = 1.0;   // A_2[0, 0]; A_2[1, 1] = 0: row 1 of degree 1
+  a(0 * 4 + 2, 0) = 0.7;   // A_0[1, 0]: triangular coupling
+  const lptv::MimoModel m(a, b, 2, 1, w0);
+  REQUIRE(lptv::row_degrees(m) == std::vector<int>{2, 1});
+  const auto f = lptv::floquet(m);
+  REQUIRE(f.multipliers.size() == 3);
+  for (cd p : {cd(-0.2, 3.0), cd(-0.2, -3.0), cd(-1.5, 0.0)}) {
+    const cd mu = std::exp(p * T0);
+    REQUIRE((f.multipliers.array() - mu).abs().minCoeff() <= 1e-12 * std::abs(mu));
+  }
+  REQUIRE(f.is_stable);
+}
+
+TEST_CASE("several outputs: a 1 x 1 model has the SISO multipliers", "[floquet][mimo]") {
+  for (const lptv::Model& m : {paper_model(), mathieu(0.05, 1.3, 0.3, 2.1), mathieu(0.02, 1.0, 0.1, 2.0)}) {
+    const auto f = lptv::floquet(m);
+    const auto g = lptv::floquet(lptv::MimoModel(m));
+    REQUIRE(g.is_stable == f.is_stable);
+    REQUIRE(g.multipliers.size() == f.multipliers.size());
+    for (Eigen::Index i = 0; i < f.multipliers.size(); ++i) {
+      const double tol = 2 * (f.error_estimate[i] + g.error_estimate[i]) * std::abs(f.multipliers[i]);
+      REQUIRE(std::abs(g.multipliers[i] - f.multipliers[i]) <= tol);
+    }
+  }
+}
+
+TEST_CASE("several outputs: a singular leading row coefficient matrix is refused", "[floquet][mimo]") {
+  Eigen::MatrixXcd a = Eigen::MatrixXcd::Zero(2 * 4, 3), b = Eigen::MatrixXcd::Ones(2, 1);
+  a(4 + 0, 1) = a(4 + 3, 1) = 1.0;  // A_1 = I + the (0, 0) entry's cos(t)
+  a(4 + 0, 0) = a(4 + 0, 2) = 0.5;  // A_1[0, 0](t) = 1 + cos(t): zero at t = pi
+  a(0, 1) = a(3, 1) = 0.3;
+  REQUIRE_THROWS_AS(lptv::floquet(lptv::MimoModel(a, b, 2, 1, 1.0)), std::invalid_argument);
+}
+
+TEST_CASE("several outputs: Hill's multipliers are the eigenvalues of the products", "[floquet][mimo]") {
+  // Two masses, M = diag(1, 2), C = 0.02 M, coupling spring 2 (1 + depth cos(w0 t)) pumped at
+  // w0 = 2 w_1 = 2.8917: stable at depth 0.05, unstable at 0.4.
+  for (double depth : {0.05, 0.4}) {
+    Eigen::MatrixXcd a = Eigen::MatrixXcd::Zero(3 * 4, 3), b = Eigen::MatrixXcd::Zero(4, 1);
+    const double K[2][2] = {{7.0, -2.0}, {-2.0, 5.0}}, S[2][2] = {{1.0, -1.0}, {-1.0, 1.0}};
+    for (int p = 0; p < 2; ++p) {
+      for (int q = 0; q < 2; ++q) {
+        a(p * 2 + q, 1) = K[p][q];
+        a(p * 2 + q, 0) = a(p * 2 + q, 2) = depth * S[p][q];
+      }
+      a(4 + p * 3, 1) = 0.02 * (p + 1);
+      a(8 + p * 3, 1) = 1.0 * (p + 1);
+      b(p * 3, 0) = 1.0;
+    }
+    const double w1 = std::sqrt((19.0 - std::sqrt(113.0)) / 4.0);
+    const lptv::MimoModel m(a, b, 2, 2, 2 * w1);
+    const auto f = lptv::floquet(m);
+    const Eigen::MatrixXd Phi = lptv::monodromy(m, 2000);
+    REQUIRE(f.multipliers.size() == 4);
+    REQUIRE(distance_to_eig(f.multipliers, Phi) <= 1e-10 * Phi.norm());
+    REQUIRE(f.is_stable == (depth < 0.1));
+  }
+}

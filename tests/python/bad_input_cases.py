@@ -13,6 +13,7 @@ tests/python/test_bad_inputs.py and bench/python/bad_inputs.py.
 from __future__ import annotations
 
 import functools
+import importlib
 import json
 import re
 import tempfile
@@ -959,6 +960,25 @@ def python_cases():
         Case("simulate-mimo-lti", "value", lambda: lp().simulate(mimo(), np.array([[0.0], [1.0]])),
              check=lambda Y: np.allclose(Y[1], np.linalg.solve(np.diag([2.0, 3.0]) + 1j * np.eye(2), [1.0, 1.0]))),
     ]
+    zero_row = np.zeros((2, 2, 2))
+    zero_row[1, 0, 0] = zero_row[0, 0, 0] = 1.0                 # row 1 of A holds nothing
+    C += [
+        Case("floquet-mimo-tol", "range", lambda: lp().floquet(mimo(), tol=-1.0), match=names("tol")),
+        Case("floquet-mimo-zero-row", "value", lambda: lp().floquet(mimo(a=zero_row)), match=names("a")),
+        Case("floquet-mimo-lti", "value", lambda: lp().floquet(mimo()),
+             check=lambda f: np.allclose(np.sort(f.exponents.real), [-3.0, -2.0], rtol=1e-10)),
+        Case("frozen_poles-mimo-t-nan", "nan/inf", lambda: lp().frozen_poles(mimo(), [NaN]), match=names("t")),
+        Case("frozen_poles-mimo-zero-row", "value", lambda: lp().frozen_poles(mimo(a=zero_row), [0.0]),
+             match=names("model")),
+        Case("monodromy-mimo-steps", "range",
+             lambda: importlib.import_module("lptv.floquet").monodromy(mimo(), steps=0), match=names("steps")),
+        Case("read_measurements-u-list-int", "type",
+             lambda: lp().read_measurements(good_npz(), u=["u", 3], y=["y", "w0"]), match=names("u")),
+        Case("read_measurements-y-list-empty", "size", lambda: lp().read_measurements(good_npz(), y=[]),
+             match=names("y")),
+        Case("read_measurements-several-twice", "value",
+             lambda: lp().read_measurements(good_npz(), u=["u", "y"], y=["y"]), match=names("y")),
+    ]
     C += family("mimo_multisines", "n_inputs", lambda v: lp().mimo_multisines([1, 2], 16, v), INT_BAD)
     C += family("mimo_multisines", "n_samples", lambda v: lp().mimo_multisines([1], v, 2), INT_BAD)
     C += [
@@ -1117,6 +1137,10 @@ def cli_cases():
     add("identify-input-missing", ok + ("--input", "force"), "--input")
     add("identify-output-missing", ok + ("--output", "disp"), "--output")
     add("identify-output-two", ok + ("--output", "y,u"), "--output")
+    add("identify-outputs-missing", ok + ("--output", "y,force"), "--output")
+    add("identify-outputs-empty-name", ok + ("--output", "y,"), "--output")
+    add("identify-outputs-known", ok + ("--output", "y,w0", "--known", "a1=1"), "--known")
+    add("identify-outputs-scale", ok + ("--output", "y,w0", "--scale", "b0=1"), "--scale")
     add("identify-time-missing", ok + ("--time", "clock"), "--time")
     add("identify-resume-one-file", ok + ("--resume",), "--resume")
     add("identify-resume-nothing", ok + ("--workers", "1", "--out", "{dir}/batch", "--resume"), "--resume")

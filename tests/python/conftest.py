@@ -290,6 +290,43 @@ def floquet_tol():
 
 
 # ==================================================================================================
+# Floquet multipliers and frozen poles of the matrix system: tests/python/test_mimo_floquet.py.
+# ==================================================================================================
+
+# Hill's multipliers of the observer form against eig of the monodromy matrix from DOP853 at
+# rtol MIMO_FLOQUET_IVP_RTOL (atol 1e-3 of it) of the state equations written out by hand,
+# relative to ||Phi||_2. DOP853 keeps each step's local error below rtol |x| + atol; over one
+# period of these systems (|mu| from 0.13 to 5) the global error is a modest multiple of rtol
+# ||Phi||, and eig adds eps ||Phi|| kappa_i with kappa_i <= MIMO_FLOQUET_KAPPA_MAX (checked,
+# measured <= 3.6); Hill's own error is below 1e-11 in ln(mu) (its error_estimate, measured
+# <= 3e-13). 1e-10 is a hundred rtol; measured: 3.5e-14 .. 3.8e-13 over 35 systems.
+MIMO_FLOQUET_IVP_RTOL = 1e-12
+MIMO_FLOQUET_VS_IVP = 1e-10
+MIMO_FLOQUET_KAPPA_MAX = 1e3
+# The spectral radius must differ from 1 by this much for a verdict to be compared (a system on
+# the tongue's edge is marginal, and both routes' errors could put it on either side); the
+# systems of the tests are 2.6e-3 or more away.
+MIMO_FLOQUET_MARGIN = 1e-4
+
+# Discrete time, the core's product against NumPy's, in units of kappa_max ||Phi||_2: both round
+# each of the N = 24 steps by a few eps ||G_k|| (||G_k|| of order 1 here), so the two Phi differ
+# by about N eps prod ||G_k|| and the eigenvalues by kappa_i times that. Measured: 6e-17 ..
+# 6.4e-16 over 20 systems; 1e-13 is 150 times that.
+MIMO_FLOQUET_DT = 1e-13
+
+# 1 x 1 models, the observer form against the SISO companion form: ln(mu) paired within twice
+# the sum of both error estimates plus this (1 + |ln|mu||) (Hill's tol is 1e-11; the products
+# are exact to rounding). Measured: the distance is at most 0.36 of the estimates' sum (1.75e-10
+# against 6.2e-9 on the paper's model).
+MIMO_FLOQUET_SISO = 1e-12
+
+# Frozen poles against numpy.roots of det A(s) built by numpy.polymul, relative to max(1, |root|):
+# the roots of a degree 3 .. 4 polynomial with well separated roots carry about 1e2 eps each,
+# eig of the observer matrix the same. Measured: at most 1.9e-15 over 45 cases; 1e-12.
+MIMO_FROZEN_POLES = 1e-12
+
+
+# ==================================================================================================
 # Batch runs and Monte Carlo studies: tests/python/test_batch.py and test_cli_batch.py.
 # ==================================================================================================
 

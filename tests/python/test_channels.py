@@ -114,13 +114,19 @@ def test_names_match_a_header_with_a_unit_and_an_ambiguous_name_lists_the_candid
     assert "input 'Force (N)', output 'displacement [m]'" in out.splitlines()[0]
 
 
-def test_several_outputs_are_refused_one_at_a_time(record, tmp_path, capsys):
-    src = rig_csv(tmp_path / "rig.csv", *record)
-    rc, out, err = identify_cli(capsys, src, "--input", "force", "--output", "displacement,time",
-                                "--period", T0, *FIT)
-    assert rc == 2 and "one output at a time (MIMO models are not supported yet)" in err
-    with pytest.raises(FileError, match="must name one output channel, got 2"):
-        lptv.read_measurements(src, u="force", y=["displacement", "time"], period=T0)
+def test_several_outputs_are_read_as_channels_of_one_record(record, tmp_path):
+    """A list of outputs is a record of several channels (test_mimo_measurements.py); the
+    command line takes a comma list to the fit of several channels (test_cli_mimo.py)."""
+    u, y = record
+    src = tmp_path / "rig.csv"
+    np.savetxt(src, np.column_stack([np.arange(u.size) / FS, u.ravel(), y.ravel(), 2 * y.ravel()]), fmt="%.17g",
+               delimiter=",", header="time,force,displacement,velocity", comments="")
+    m = lptv.read_measurements(src, u="force", y=["displacement", "velocity"], period=T0)
+    assert m.u.shape == (P, N, 1) and m.y.shape == (P, N, 2) and m.output == ("displacement", "velocity")
+    np.testing.assert_array_equal(m.y[..., 0], y)
+    np.testing.assert_array_equal(m.y[..., 1], 2 * y)
+    with pytest.raises(FileError, match="channel 'force' is named twice"):
+        lptv.read_measurements(src, u="force", y=["displacement", "force"], period=T0)
 
 
 def test_a_time_column_in_ms_and_the_given_fs_or_periods_take_precedence(record, tmp_path):

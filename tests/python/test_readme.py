@@ -10,7 +10,8 @@ DOCS = [README] + sorted((ROOT / "docs" / "guide").glob("*.md"))
 MARKERS = ("lptv.frozen_poles(res.model", "lptv.inspect(", "lptv.read_measurements(", "lptv.montecarlo(",
            "records.append(", "lptv.plots.distortion(d)", "lptv.min_crest_multisine(", "transient_record(",
            "continuous=True", 'referred="input"', 'referred="none"', 'disturbances="remove"',
-           "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", "res.noise_choice")
+           "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", "res.noise_choice",
+           'u=["f1", "f2"]', "from lptv import floquet, frozen_poles")
 
 
 def all_text():
@@ -269,3 +270,35 @@ def test_guide_identify_example_runs(tmp_path, monkeypatch):
     assert res.noise == "moderated" and res.noise_choice.startswith("moderated: the noise spectrum is smooth")
     assert res.converged and res.model_ok and (res.parameter_std[res.parameter_std > 0]).size == 34
     assert quick.converged and quick.covariance is None
+
+
+def test_guide_reading_several_channels_runs(tmp_path, monkeypatch):
+    """The files of two experiments of the two-mass system read back as (P, N, 2) arrays: the
+    samples written (savetxt's 18 digits), the names as the header has them."""
+    import numpy as np
+
+    ns = run_block('u=["f1", "f2"]', tmp_path, monkeypatch)
+    m, d = ns["m"], ns["d"]
+    assert m.u.shape == (4, 256, 2) and m.y.shape == (4, 256, 2)
+    assert m.input == ("F1 [N]", "F2 [N]") and m.output == ("x1 [m]", "x2 [m]")
+    assert m.fs_source == "column 'time [s]'" and abs(m.fs - 256 / (2 * np.pi)) <= 1e-9 * m.fs      # fs of the times, to 9 digits
+    # the samples written: the multisine and the simulated steady state, plus noise of std 1e-3
+    np.testing.assert_allclose(m.u, np.broadcast_to(d.signals[0], (4, 256, 2)), rtol=0, atol=6e-3)
+    assert np.abs(m.y - ns["y0"][:, :, 0]).max() < 6e-3
+    # the fit: consistent, and K(t)'s harmonic within 5 standard deviations of 0.3 S
+    res = ns["res"]
+    assert res.model_ok
+    S = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    for i, name in enumerate(res.parameter_names):
+        if name.startswith("a0[") and name.endswith(".re1"):
+            p, q = int(name[3]), int(name[5])
+            assert abs(res.eta[i] - 0.3 * S[p, q]) <= 5 * res.parameter_std[i], name
+
+
+def test_guide_stability_of_several_outputs_runs(tmp_path, monkeypatch):
+    """The pumped two masses: damped frozen poles, unstable at depth 0.4 (the last of the loop)
+    with the spectral radius printed (1.0273; solve_ivp agrees in test_mimo_floquet.py)."""
+    ns = run_block("from lptv import floquet, frozen_poles", tmp_path, monkeypatch)
+    f, poles = ns["f"], ns["poles"]
+    assert poles.shape == (50, 4) and poles.real.max() < 0
+    assert not f.is_stable and round(f.spectral_radius, 4) == 1.0273

@@ -4,7 +4,9 @@
 #pragma once
 #include <Eigen/Dense>
 #include <string>
+#include <vector>
 
+#include "lptv/mimo.hpp"
 #include "lptv/model.hpp"
 
 namespace lptv {
@@ -53,6 +55,29 @@ struct Floquet {
 // the time or sample) or an option is out of range, NumericalError when the exponents do not
 // converge by opt.max_truncation (naming the M reached) or 1/a_na(t) needs too many harmonics.
 Floquet floquet(const Model& m, const FloquetOptions& opt = FloquetOptions());
+
+// Several outputs (METHOD.md section 19, "Stability of the matrix system"): the multipliers of
+// sum_n A_n(t) d^n y = 0 for a row-reduced A(t, s) (row degrees d_p, the leading row coefficient
+// matrix L(t), row p from A_{d_p}(t), invertible over the period). The state is the observer
+// form of the right-form coefficients, of dimension sum_p d_p, so there are that many
+// multipliers; continuous time by Hill's method, discrete time by the product of the N one-step
+// matrices, with the options, errors and verdict of floquet(const Model&). A 1 x 1 model has
+// the SISO model's multipliers (to their error estimates: the state differs).
+// Throws std::invalid_argument naming the time or sample where L is singular, or the row of A
+// that is zero.
+Floquet floquet(const MimoModel& m, const FloquetOptions& opt = FloquetOptions());
+
+// The row degrees d_p of A(t, s): the highest order with a nonzero coefficient in row p.
+std::vector<int> row_degrees(const MimoModel& m);
+
+// The monodromy matrix of that state form by products, for checks (as monodromy(const Model&)):
+// continuous time `steps` fourth-order Magnus steps and 2 steps, extrapolated; discrete time the
+// product of the N one-step matrices (`steps` ignored). sum_p d_p square.
+Eigen::MatrixXd monodromy(const MimoModel& m, int steps);
+
+// The state matrix of that form at time t (continuous time: x' = F(t) x) or the one-step
+// matrix of sample t / ts (discrete time: x[k+1] = G[k] x[k]); sum_p d_p square.
+Eigen::MatrixXd state_matrix_at(const MimoModel& m, double t);
 
 // The monodromy matrix Phi (na x na) by an independent route, for checks:
 //  - continuous time: the product of exp(Omega_k) over `steps` equal sub-intervals of one

@@ -77,6 +77,9 @@ is checked against the one the input repeats at (lptv inspect FILE shows it; --n
 skips the check). Exit status 0: the model is consistent with the data; 3: the verdict finds
 model errors; 4: the data do not determine the model; 2: a file or option that cannot be used;
 1: a computation that failed.
+Several inputs and outputs: --input f1,f2 --output x1,x2 (comma lists); every file is then one
+experiment of one system and all are fitted together into one matrix model (model.json,
+summary.json, the parameters with their std and the verdict printed).
 Several files (or --workers / --scheduler) make a batch: one row per file in results.csv,
 each model in models/, the fits on local processes or a Dask cluster. With --joint the files
 are records of one system (same period) fitted together into one model and one report."""
@@ -92,7 +95,8 @@ def add_parser(sub):
                "  lptv identify rig.csv --input force --output displacement --period 10 --na 2 --nb 0 --ka 1\n"
                "  lptv identify meas.npz --na 2 --nb 1 --ka 3 --kb 3 --lines 1-243\n"
                "  lptv identify runs/*.npz --na 2 --nb 1 --ka 3 --kb 3 --workers 2\n"
-               "  lptv identify low.npz high.npz --joint --na 2 --nb 1 --method sml")
+               "  lptv identify low.npz high.npz --joint --na 2 --nb 1 --method sml\n"
+               "  lptv identify e1.csv e2.csv --input f1,f2 --output x1,x2 --w0 1 --na 2 --nb 0 --ka 1,0,0")
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurements: .csv, .npz or .mat; several files are fitted as a batch")
     p.add_argument("--na", type=int, required=True, help="order of the output side")
@@ -119,9 +123,11 @@ def add_parser(sub):
     p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "
                    "to state how the record was sampled for a continuous-time model use --fs or --dt")
     p.add_argument("--input", metavar="NAME",
-                   help="the input channel: a CSV column, NPZ array or MAT variable (default u)")
+                   help="the input channel: a CSV column, NPZ array or MAT variable (default u); several as a "
+                        "comma list")
     p.add_argument("--output", metavar="NAME",
-                   help="the output channel (default y); one at a time, MIMO models are not supported yet")
+                   help="the output channel (default y); several as a comma list (--input f1,f2 --output x1,x2): "
+                        "the files are then experiments of one system of several inputs and outputs")
     p.add_argument("--time", metavar="NAME",
                    help="a time column or variable (s) giving fs, checked uniform (default: one named t or "
                         "time); without --fs, --dt and --periods the file's time or stored fs / dt / Ts is used")
@@ -236,6 +242,10 @@ def _read_failure_cause(diag, args, error):
 # ------------------------------------------------------------------------------ running
 
 def run(args) -> int:
+    from lptv.apps import mimoid
+
+    if mimoid.several_channels(args):      # --input f1,f2 / --output x1,x2: one fit of all the files
+        return mimoid.run(args)
     if args.covariance != "analytic" and (args.joint or len(args.files) > 1 or args.workers is not None
                                           or args.scheduler is not None):
         print(f"lptv identify: error: --covariance {args.covariance} takes one record at a time (not several "

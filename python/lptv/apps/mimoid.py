@@ -1,0 +1,240 @@
+"""``lptv identify FILES... --input f1,f2 --output x1,x2``: a model of several inputs and outputs.
+
+Each file holds every channel of one experiment (P >= 2 steady-state periods; CSV columns, NPZ
+arrays or MAT variables named by ``--input`` and ``--output``, comma lists, matched as for one
+channel: up to case and a trailing unit). The files are experiments of one system (the same
+period), fitted together into one :class:`lptv.MimoModel` by :func:`lptv.identify` on the list
+of (u, y) pairs, u of shape (P, N, nu) and y (P, N, ny) (METHOD.md section 19); ``--joint`` says
+the same and may be given. A single file is one experiment (enough for one input, or when the
+inputs excite different lines). Writes ``model.json`` (:meth:`lptv.MimoModel.load`) and
+``summary.json``, prints the parameters with their standard deviations, the verdict and the
+estimate's stability (its Floquet multipliers); no report.html yet. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4 no verdict,
+2 a file or option that cannot be used (a one-line error), 1 a computation that failed.
+
+Example::
+
+    lptv identify exp1.csv exp2.csv --input f1,f2 --output x1,x2 --w0 1 --na 2 --nb 0 --ka 1,0,0
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import lptv
+from lptv import NumericalError
+from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fundamental, in_option_terms, integer,
+                               output_folder, parse_counts, parse_lines, positive, read_options)
+from lptv.apps.report import write_fit
+from lptv.measurements import FileError, read_measurements
+
+NEEDS_FIT = ("several inputs or outputs need the MIMO fit (lptv.identify on arrays (P, N, nu), (P, N, ny)), "
+             "which this lptv does not have yet")
+"""The error when lptv.identify does not take several channels."""
+
+# Options of the one-channel fit that the fit of several channels does not take (and their
+# value when not given).
+_NOT_FOR_MIMO = {"one_record": False, "input_noise": None, "remove_disturbances": False, "known": None,
+                 "scale": None, "workers": None, "scheduler": None, "resume": False}
+
+
+def several_channels(args) -> bool:
+    """Whether ``--input`` or ``--output`` names several channels (a comma list)."""
+    return any(v is not None and "," in v for v in (args.input, args.output))
+
+
+def channel_list(text, opt):
+    """['f1', 'f2'] from 'f1, f2'; FileError for an empty name."""
+    if text is None:
+        return None
+    names = [n.strip() for n in text.split(",")]
+    if any(not n for n in names):
+        raise FileError(f"{opt} '{text}': an empty channel name in the comma list")
+    return names
+
+
+def mimo_fit_available() -> bool:
+    """Whether :func:`lptv.identify` fits several inputs and outputs (the MIMO estimators)."""
+    return hasattr(lptv, "MimoIdentificationResult")
+
+
+def _fail(problem, status=2) -> int:
+    print(f"lptv identify: error: {' '.join(str(problem).split())}", file=sys.stderr)
+    return status
+
+
+def _check_options(args):
+    for key, default in _NOT_FOR_MIMO.items():
+        if getattr(args, key, default) != default:
+            opt = "--" + key.replace("_", "-")
+            raise FileError(f"{opt} is for one input and one output; several channels take the files, "
+                            "--input, --output, the structure, --lines, --method, --max-iter, --tol and --out")
+    if getattr(args, "noise", None) == "moderated":     # the fit of several channels weighs by the sample's
+        raise FileError("--noise moderated is for one input and one output")
+    if getattr(args, "referred", "auto") not in ("auto",):
+        raise FileError("--referred is for records of realisations of one input and one output")
+    if args.covariance != "analytic":
+        raise FileError(f"--covariance {args.covariance} is for one input and one output; several channels "
+                        "take the analytic covariance")
+    if args.max_iter < 0:
+        raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
+    for opt in ("na", "nb", "max_iter"):
+        integer(getattr(args, opt), "--" + opt.replace("_", "-"))
+    positive(args.tol, "--tol")
+
+
+def read_experiments(args):
+    """(file, Measurements) per file, u (P, N, nu) and y (P, N, ny), and the common w0 and ts."""
+    inputs = channel_list(args.input, "--input") or ["u"]
+    outputs = channel_list(args.output, "--output") or ["y"]
+    records, w0s = [], []
+    ts = args.ts
+    for src in args.files:
+        try:
+            kw = read_options(args)
+            kw.update(u=inputs, y=outputs)
+            meas = read_measurements(src, **kw)
+            if args.discrete:
+                if args.ts is not None:
+                    raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
+                if meas.fs is None:
+                    raise FileError("--discrete needs the sampling frequency --fs (or --dt)")
+                ts = 1.0 / meas.fs
+            saved, args.ts = args.ts, ts
+            try:      # the samples per period are read from a channel's (P, N) periods
+                w0s.append(fundamental(args, dataclasses.replace(meas, u=meas.u[..., 0], y=meas.y[..., 0])))
+            finally:
+                args.ts = saved
+        except (FileError, ValueError) as e:
+            raise FileError(f"{src}: {e}") from None
+        records.append((src, meas))
+    for (src, _), w in zip(records[1:], w0s[1:]):
+        if not np.isclose(w, w0s[0], rtol=1e-9, atol=0):
+            raise FileError(f"{src}: w0 = {w:.10g} rad/s, but {records[0][0]} has {w0s[0]:.10g}: the experiments of "
+                            "one fit share the period")
+    return records, w0s[0], ts
+
+
+def run(args) -> int:
+    try:
+        output_folder(args.out)
+    except OSError as e:
+        return _fail(f"{e.filename or args.out}: {e.strerror or e}")
+    try:
+        _check_options(args)
+        lines = parse_lines(args.lines) if args.lines is not None else None
+        ka, kb = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb")
+        records, w0, ts = read_experiments(args)
+        if not mimo_fit_available():
+            raise FileError(NEEDS_FIT)
+    except (FileError, ValueError) as e:
+        return _fail(e)
+    files = [r[0] for r in records]
+    experiments = [(m.u, m.y) for _, m in records]
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = lptv.identify(experiments, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
+                                lines=lines, method=args.method, tol=args.tol, max_iter=args.max_iter)
+    except NumericalError as e:
+        return _fail(in_option_terms(_named(e, files), OPTION_NAMES), status=1)
+    except ValueError as e:
+        return _fail(in_option_terms(_named(e, files), OPTION_NAMES))
+    notes = [str(w.message) for w in caught if str(w.message) not in getattr(res, "warnings", ())]
+
+    out = Path(args.out) if args.out else Path(Path(files[0]).stem + "-lptv")
+    first = records[0][1]
+    print(f"lptv identify: {len(files)} experiment{'s' if len(files) > 1 else ''}, "
+          f"{res.model.n_inputs} inputs ({', '.join(first.input)}), {res.model.n_outputs} outputs "
+          f"({', '.join(first.output)}), w0 = {w0:.6g} rad/s"
+          + (f", discrete-time model with ts = {ts:g} s" if ts else ", continuous-time model") + f" -> {out}/")
+    for e, (src, meas) in enumerate(records):
+        print(f"  #{e} {src} ({meas.format}): {meas.u.shape[0]} periods of {meas.u.shape[1]} samples")
+    print(text_summary(res))
+    stability = stability_of(res.model)
+    print(f"stability: {stability['text']}")
+    for msg in list(getattr(res, "warnings", ())) + notes:
+        print(f"warning: {msg}")
+    summary = json_summary(args, records, w0, ts, ka, kb, res, notes)
+    summary["stability"] = {k: v for k, v in stability.items() if k != "text"}
+    failed = write_fit(out, res.model, summary, None)
+    if failed:
+        return _fail(failed[1] if failed[0] is None else f"{failed[0]}: {failed[1]}")
+    return status_of(res)
+
+
+def stability_of(model) -> dict:
+    """The Floquet multipliers of the estimate (:func:`lptv.floquet` of the matrix system) as
+    plain values, with a sentence; ``is_stable`` None when they could not be computed."""
+    try:
+        f = lptv.floquet(model)
+    except (ValueError, NumericalError) as e:
+        return {"is_stable": None, "spectral_radius": None, "multipliers": None,
+                "text": f"not decided ({' '.join(str(e).split())})"}
+    word = "stable" if f.is_stable else "NOT stable"
+    return {"is_stable": bool(f.is_stable), "spectral_radius": float(f.spectral_radius),
+            "multipliers": [[float(m.real), float(m.imag)] for m in f.multipliers],
+            "text": f"{word}: {f.multipliers.size} Floquet multipliers, the largest of magnitude "
+                    f"{f.spectral_radius:.6g} (lptv.floquet)"}
+
+
+def status_of(res) -> int:
+    """0 consistent, MODEL_REJECTED (3) for model errors, NOT_DETERMINED (4) without a verdict."""
+    if res.model_ok is None:
+        return NOT_DETERMINED
+    return 0 if res.model_ok else MODEL_REJECTED
+
+
+def _named(e, files) -> str:
+    """The library's message with the list positions replaced by the files."""
+    return re.sub(r"experiments?\[(\d+)\]|experiment (\d+)",
+                  lambda m: files[int(m.group(1) or m.group(2))] if int(m.group(1) or m.group(2)) < len(files)
+                  else m.group(0), str(e))
+
+
+def _std(res):
+    try:
+        return res.parameter_std
+    except (ValueError, AttributeError):
+        return None
+
+
+def text_summary(res) -> str:
+    """The method, convergence, the parameters with their standard deviations, the verdict."""
+    std = _std(res)
+    lines = [f"method {res.method.upper()}, converged {res.converged}, cost {res.cost:.4g}, "
+             f"{res.lines.size} rows, {getattr(res, 'n_free_parameters', res.eta.size)} free parameters"]
+    width = max((len(n) for n in res.parameter_names), default=9)
+    lines.append(f"{'parameter':<{width}}  {'estimate':>14}  {'std':>11}")
+    for i, name in enumerate(res.parameter_names):
+        s = "-" if std is None or not np.isfinite(std[i]) else f"{std[i]:11.4g}"
+        if std is not None and std[i] == 0:
+            s = "(normalised)"
+        lines.append(f"{name:<{width}}  {res.eta[i]:14.7g}  {s:>11}")
+    lines.append(f"verdict: {res.verdict}")
+    return "\n".join(lines)
+
+
+def json_summary(args, records, w0, ts, ka, kb, res, notes) -> dict:
+    std = _std(res)
+    first = records[0][1]
+    return {
+        "files": [str(src) for src, _ in records], "n_experiments": len(records),
+        "experiments": [{"file": str(src), "format": m.format, "periods": int(m.u.shape[0]),
+                         "samples_per_period": int(m.u.shape[1]), "fs": m.fs, "fs_source": m.fs_source}
+                        for src, m in records],
+        "inputs": list(first.input), "outputs": list(first.output),
+        "n_inputs": res.model.n_inputs, "n_outputs": res.model.n_outputs,
+        "w0": w0, "ts": ts, "na": res.model.na, "nb": res.model.nb, "ka": ka, "kb": kb,
+        "method": res.method, "n_rows": int(res.lines.size), "converged": bool(res.converged),
+        "cost": float(res.cost),
+        "parameters": [{"name": n, "value": float(res.eta[i]),
+                        "std": None if std is None else float(std[i])}
+                       for i, n in enumerate(res.parameter_names)],
+        "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
+        "warnings": list(getattr(res, "warnings", ())) + notes,
+    }

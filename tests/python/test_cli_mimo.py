@@ -1,0 +1,222 @@
+"""``lptv identify FILES... --input f1,f2 --output x1,x2``: several inputs and outputs from files.
+
+The records are made outside lptv: SciPy's solve_ivp (DOP853) of the two-mass system of
+test_mimo_timedomain.py (M y'' + C y' + K(t) y = u, coupling spring k_c(t) = 2 (1 + 0.3 cos t)),
+at its periodic steady state (shooting), under multisines made with NumPy, one experiment per
+file with its own random phases, P noisy periods written as CSV columns. The command must give
+the model lptv.identify gives on the same arrays, exit 0 for the right structure and 3 when a
+harmonic of K(t) is missing; the options it cannot use and the channels it cannot find are
+one-line errors with exit status 2.
+"""
+import json
+import re
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import lptv
+from lptv.apps import cli, mimoid
+
+W0, N, P = 1.0, 64, 8
+T0 = 2 * np.pi / W0
+LINES = np.arange(1, 24, 2)            # odd lines: the +-1 sidebands of K(t) fall on even ones
+NOISE = 1e-4
+Mm, Cm, K0 = np.diag([1.0, 2.0]), np.diag([1.0, 2.0]), np.diag([5.0, 3.0])
+S = np.array([[1.0, -1.0], [-1.0, 1.0]])
+KC0, DEPTH = 2.0, 0.3
+
+
+def true_model():
+    Kh = np.zeros((2, 2, 3))
+    Kh[:, :, 1] = K0 + KC0 * S
+    Kh[:, :, 0] = Kh[:, :, 2] = KC0 * DEPTH / 2 * S
+    return lptv.MimoModel.mechanical(Mm, Cm, Kh, np.eye(2), w0=W0)
+
+
+def steady_period(seed):
+    """One period (N samples) of u (2 channels) and y (2 channels) at periodic steady state."""
+    rng = np.random.default_rng(seed)
+    phi = rng.uniform(0, 2 * np.pi, (2, LINES.size))
+    Minv = np.linalg.inv(Mm)
+
+    def u(t):
+        return np.sum(np.cos(np.multiply.outer(LINES * W0, np.atleast_1d(t))[None] + phi[:, :, None]), axis=1)
+
+    def f(t, x, forced=True):
+        y, v = x[:2], x[2:]
+        K = K0 + KC0 * (1 + DEPTH * np.cos(W0 * t)) * S
+        acc = -Minv @ (Cm @ v + K @ y) + (Minv @ u(t)[:, 0] if forced else 0)
+        return np.concatenate([v, acc])
+
+    def augmented(t, z):
+        Phi = z[4:].reshape(4, 4)
+        return np.concatenate([f(t, z[:4]), np.column_stack([f(t, Phi[:, j], False) for j in range(4)]).ravel()])
+
+    sol = solve_ivp(augmented, (0, T0), np.concatenate([np.zeros(4), np.eye(4).ravel()]), method="DOP853",
+                    rtol=1e-11, atol=1e-13)
+    Phi = sol.y[4:, -1].reshape(4, 4)
+    x0 = np.linalg.solve(np.eye(4) - Phi, sol.y[:4, -1])
+    t = np.arange(N) * T0 / N
+    sol = solve_ivp(f, (0, T0), x0, method="DOP853", rtol=1e-11, atol=1e-13, t_eval=t)
+    return u(t).T, sol.y[:2].T
+
+
+@pytest.fixture(scope="module")
+def experiments():
+    """Two experiments (u, y) of shape (P, N, 2), noisy periods of the steady state."""
+    out = []
+    for e in range(2):
+        u1, y1 = steady_period(10 + e)
+        rng = np.random.default_rng(20 + e)
+        u = np.tile(u1, (P, 1, 1)) + NOISE * rng.standard_normal((P, N, 2))
+        y = np.tile(y1, (P, 1, 1)) + NOISE * rng.standard_normal((P, N, 2))
+        out.append((u, y))
+    return out
+
+
+def write_csv(path, u, y, header="time,F1 [N],f2 [N],x1 [m],x2 [m]"):
+    t = np.arange(P * N) * T0 / N
+    np.savetxt(path, np.column_stack([t, u.reshape(-1, 2), y.reshape(-1, 2)]), fmt="%.17g", delimiter=",",
+               header=header, comments="")
+    return path
+
+
+@pytest.fixture()
+def files(experiments, tmp_path):
+    return [write_csv(tmp_path / f"exp{e}.csv", *experiments[e]) for e in range(2)]
+
+
+def identify_cli(capsys, *argv):
+    rc = cli.main(["identify", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+FIT = ["--input", "f1,f2", "--output", "x1,x2", "--period", T0, "--na", "2", "--nb", "0", "--ka", "1,0,0"]
+
+needs_fit = pytest.mark.skipif(not mimoid.mimo_fit_available(), reason="lptv.identify takes one channel only")
+
+
+def true_value(name):
+    """The normalised true parameter 'a0[1,0].re1' (A_na,0 = I: M^-1 times the equation)."""
+    side, order, p, q, part, k = re.fullmatch(r"([ab])(\d)\[(\d),(\d)\]\.(re|im)(\d)", name).groups()
+    Minv = np.linalg.inv(Mm)
+    model = true_model()
+    c = np.einsum("pr,nrqk->npqk", Minv, model.a if side == "a" else model.b)
+    K = (c.shape[3] - 1) // 2
+    v = c[int(order), int(p), int(q), K + int(k)] if int(k) <= K else 0.0
+    return v.real if part == "re" else v.imag
+
+
+@needs_fit
+@pytest.mark.parametrize("method", ["wgtls", "sml"])
+def test_the_command_gives_the_python_api_model_and_accepts_the_right_structure(method, experiments, files,
+                                                                                 tmp_path, capsys):
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--method", method, "--out", tmp_path / "o")
+    assert rc == 0, out + err
+    assert "2 experiments, 2 inputs (F1 [N], f2 [N]), 2 outputs (x1 [m], x2 [m])" in out.splitlines()[0]
+    assert "verdict: consistent" in out
+    res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0, method=method)
+    f = lptv.floquet(res.model)
+    assert f"stability: stable: 4 Floquet multipliers, the largest of magnitude {f.spectral_radius:.6g}" in out
+    model = lptv.MimoModel.load(tmp_path / "o" / "model.json")
+    np.testing.assert_allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
+    np.testing.assert_allclose(model.b, res.model.b, rtol=0, atol=1e-10 * np.abs(res.model.b).max())
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["inputs"] == ["F1 [N]", "f2 [N]"] and summary["model_ok"] is True
+    assert [p["name"] for p in summary["parameters"]] == list(res.parameter_names)
+    std = np.array([p["std"] for p in summary["parameters"]])
+    # the estimate's multipliers: with M^-1 C = I, y = exp(-t/2) z turns the system into an
+    # undamped one (z'' + (M^-1 K(t) - I/4) z = 0, away from its resonances), whose multipliers
+    # lie on the unit circle: every |mu| is exp(-T0/2). The estimate's ln|mu| moves by T0 times
+    # the change of the damping's eigenvalues, at most that of M^-1 C's entries: 5 std of them.
+    assert summary["stability"]["is_stable"] is True
+    ln_rho = np.log(summary["stability"]["spectral_radius"])
+    damping_std = max(s for n, s in zip(res.parameter_names, std) if n.startswith("a1"))
+    assert abs(ln_rho + 0.5 * T0) <= 5 * T0 * damping_std, (ln_rho + 0.5 * T0, damping_std)
+    np.testing.assert_allclose(std, res.parameter_std, rtol=1e-8)
+    # every estimate against the system integrated by solve_ivp, within 5 standard deviations
+    free = std > 0
+    assert free.sum() == 20
+    z = [(res.eta[i] - true_value(n)) / std[i] for i, n in enumerate(res.parameter_names) if free[i]]
+    assert np.max(np.abs(z)) <= 5, z
+
+
+@needs_fit
+def test_a_missing_harmonic_is_a_model_error(files, tmp_path, capsys):
+    fit = [x if x != "1,0,0" else "0" for x in FIT]           # --ka 0: K(t) taken as constant
+    rc, out, err = identify_cli(capsys, *files, *fit, "--out", tmp_path / "o")
+    assert rc == 3, out + err
+    assert "verdict: model error" in out
+
+
+@needs_fit
+def test_npz_periods_with_a_stored_fs_and_a_discrete_time_model(experiments, tmp_path, capsys):
+    """(P, N) arrays per channel with fs stored and no period: w0 = 2 pi fs / N from one
+    channel's periods; --discrete takes ts = 1 / fs and fits the model in the shift, as
+    lptv.identify does on the same arrays with that ts."""
+    files = []
+    for e, (u, y) in enumerate(experiments):
+        files.append(tmp_path / f"e{e}.npz")
+        np.savez(files[-1], f1=u[..., 0], f2=u[..., 1], x1=y[..., 0], x2=y[..., 1], fs=N / T0)
+    argv = ["--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb", "2", "--ka", "1,0,0"]
+    rc, out, err = identify_cli(capsys, *files, *argv, "--out", tmp_path / "c")
+    assert rc in (0, 3), out + err
+    assert "w0 = 1 rad/s, continuous-time model" in out.splitlines()[0]
+    rc, out, err = identify_cli(capsys, *files, *argv, "--discrete", "--out", tmp_path / "d")
+    assert rc in (0, 3), out + err
+    summary = json.loads((tmp_path / "d" / "summary.json").read_text())
+    assert summary["ts"] == pytest.approx(T0 / N, rel=1e-12) and summary["w0"] == pytest.approx(W0, rel=1e-12)
+    model = lptv.MimoModel.load(tmp_path / "d" / "model.json")
+    res = lptv.identify(experiments, na=2, nb=2, ka=[1, 0, 0], w0=W0, ts=T0 / N)
+    assert model.discrete and np.allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
+
+
+@needs_fit
+def test_the_fit_s_refusals_name_the_options(files, tmp_path, capsys):
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--lines", "1-20", "--out", tmp_path / "o")
+    assert rc == 2 and err.startswith("lptv identify: error: --lines: line 1 (") and "outside" in err
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--method", "ls", "--out", tmp_path / "o")
+    assert rc == 2 and "--method" in err and len(err.strip().splitlines()) == 1
+
+
+@needs_fit
+def test_noise_free_records_give_the_system_and_no_verdict(tmp_path, capsys):
+    """Identical periods (no noise): no statistics, so no verdict (exit status 4) and no std; the
+    estimate is the integrated system's (DOP853 at rtol 1e-11 and a Jacobian of modest condition:
+    1e-8 of the largest coefficient; measured 8e-12)."""
+    files = []
+    for e in range(2):
+        u1, y1 = steady_period(10 + e)
+        files.append(write_csv(tmp_path / f"e{e}.csv", np.tile(u1, (P, 1, 1)), np.tile(y1, (P, 1, 1))))
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
+    assert rc == 4, out + err
+    assert "verdict: no verdict" in out
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["model_ok"] is None and all(p["std"] is None for p in summary["parameters"])
+    values = np.array([p["value"] for p in summary["parameters"]])
+    truth = np.array([true_value(p["name"]) for p in summary["parameters"]])
+    assert np.abs(values - truth).max() <= 1e-8 * np.abs(truth).max()
+
+
+def test_without_the_mimo_fit_the_command_says_so(files, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(mimoid, "mimo_fit_available", lambda: False)
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
+    assert rc == 2 and err.strip() == f"lptv identify: error: {mimoid.NEEDS_FIT}"
+    assert not (tmp_path / "o" / "model.json").exists()
+
+
+def test_channels_and_options_it_cannot_use_are_one_line_errors(files, tmp_path, capsys):
+    rc, out, err = identify_cli(capsys, *files, "--input", "f1,f3", *FIT[2:])
+    assert rc == 2 and "column 'f3', the input named by --input (u=), is missing" in err
+    assert err.startswith(f"lptv identify: error: {files[0]}: ") and len(err.strip().splitlines()) == 1
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--known", "a2=1")
+    assert rc == 2 and "--known is for one input and one output" in err
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--covariance", "bootstrap")
+    assert rc == 2 and "--covariance bootstrap is for one input and one output" in err
+    rc, out, err = identify_cli(capsys, *files, "--input", "f1,,f2", *FIT[2:])
+    assert rc == 2 and "an empty channel name" in err
+    rc, out, err = identify_cli(capsys, files[0], "--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb",
+                                "0", "--period", T0, "--fs", 3.3)
+    assert rc == 2 and "not a whole number" in err
