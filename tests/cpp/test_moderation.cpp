@@ -3,7 +3,10 @@
 #include <cmath>
 #include <complex>
 #include <stdexcept>
+#include <utility>
 #include <vector>
+
+#include <Eigen/Dense>
 
 #include "lptv/moderation.hpp"
 
@@ -111,9 +114,40 @@ lptv::FrequencyData constant_noise(int L, int P, double vu, double vy, std::comp
 
 }  // namespace
 
+// The shape factor (k, v) of inner line i (0-based, m inner lines) for log variances exactly
+// constant: the fitted shape is zero and k = n / sum_j exp(-q_j / 2) with q_j the fit's variance
+// at x_j from the window's geometry alone (METHOD.md section 7, "the spectrum's shape"); k = 1,
+// v = 0 with fewer than W lines on either side within +-2 W.
+std::pair<double, double> flat_shape(int i, int m, int W, double var_log) {
+  const int S = 2 * W;
+  if (std::min(i, S) < W || std::min(m - 1 - i, S) < W) return {1.0, 0.0};
+  double C[5] = {0, 0, 0, 0, 0};
+  for (int x = -S; x <= S; ++x) {
+    if (x == 0 || i + x < 0 || i + x >= m) continue;
+    for (int q = 0; q < 5; ++q) C[q] += std::pow(static_cast<double>(x), q);
+  }
+  Eigen::Matrix3d A;
+  A << C[0], C[1], C[2], C[1], C[2], C[3], C[2], C[3], C[4];
+  const Eigen::Matrix2d V = var_log * A.inverse().bottomRightCorner<2, 2>();
+  double es = 0, ex = 0, ex2 = 0;
+  int n = 0;
+  for (int x = -W; x <= W; ++x) {
+    if (x == 0 || i + x < 0 || i + x >= m) continue;
+    const Eigen::Vector2d X(x, static_cast<double>(x) * x);
+    const double e = std::exp(-0.5 * X.dot(V * X));
+    es += e;
+    ex += e * X[0];
+    ex2 += e * X[1];
+    ++n;
+  }
+  const Eigen::Vector2d a(ex / es, ex2 / es);
+  return {n / es, a.dot(V * a)};
+}
+
 TEST_CASE("Moderation: variances exactly as smooth as their trend", "[moderation]") {
   // No spread of log s^2 about the neighbours' mean: d0 at its cap; every inner line gets
-  // w v + (1 - w) (d0 - 2) / d0 v, w = d / (d + d0), and dof (d + d0)^2 / (d + d0 + d0^2 / (n d)).
+  // w v + (1 - w) (d0 - 2) / d0 k v, w = d / (d + d0), k the shape factor of a flat trend, and
+  // dof (d + d0)^2 / (d + d0 + d0^2 (1 / (n d) + v_k / 2)).
   const int L = 100, P = 4, W = 5;
   const double d = 6.0, d0 = lptv::kModerationMaxPriorDof, w = d / (d + d0);
   const auto data = constant_noise(L, P, 0.01, 0.04, {0.01, 0.0});
@@ -127,10 +161,14 @@ TEST_CASE("Moderation: variances exactly as smooth as their trend", "[moderation
   for (int l : {1, 2, 5, 6, 50, 94, 95, 99}) {
     INFO("line " << l);
     const double n = std::min(l - 1, W) + std::min(L - 1 - l, W);
-    const double want = w * 0.04 + (1 - w) * (d0 - 2) / d0 * 0.04;
+    const auto [k, vk] = flat_shape(l - 1, L - 1, W, lptv::trigamma(d / 2));
+    if (l == 50) CHECK(k > 1.0);                  // the fit's noise taken out of a flat shape
+    if (l == 1) CHECK(k == 1.0);                  // the first lines: no shape factor
+    const double want = w * 0.04 + (1 - w) * (d0 - 2) / d0 * k * 0.04;
     // The neighbours' sums come from running sums over the lines (L v at most against 2 W v).
     CHECK(std::abs(mod.data.varY[l] - want) <= 1e-13 * want);
-    CHECK(std::abs(mod.dof[l] - (d + d0) * (d + d0) / (d + d0 + d0 * d0 / (n * d))) <= 1e-12 * mod.dof[l]);
+    CHECK(std::abs(mod.dof[l] - (d + d0) * (d + d0) / (d + d0 + d0 * d0 * (1.0 / (n * d) + vk / 2.0)))
+          <= 1e-12 * mod.dof[l]);
     CHECK(mod.own_weight[l] == w);
     CHECK(mod.neighbour[l]);
     // |covYU|^2 <= varU varY kept: here |c| = sqrt(varU varY) before and after.

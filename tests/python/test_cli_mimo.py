@@ -220,3 +220,42 @@ def test_channels_and_options_it_cannot_use_are_one_line_errors(files, tmp_path,
     rc, out, err = identify_cli(capsys, files[0], "--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb",
                                 "0", "--period", T0, "--fs", 3.3)
     assert rc == 2 and "not a whole number" in err
+
+
+@needs_fit
+def test_the_report_shows_the_verdict_the_parameters_and_each_output_s_residue(experiments, files, tmp_path,
+                                                                              capsys):
+    """report.html: the verdict, every parameter, the residue figure of each output (its points
+    the result's |e_p|^2 / C_e[p, p] in dB, computed here from the API's result) and the
+    stability figure; --no-report writes none."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from lptv.apps import mimoreport
+
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
+    assert rc == 0, out + err
+    page = (tmp_path / "o" / "report.html").read_text()
+    res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0)
+    assert "Verdict:</b> consistent" in page
+    assert all(n in page for n in res.parameter_names)
+    assert (tmp_path / "o" / "residues.png").exists() and (tmp_path / "o" / "stability.png").exists()
+    captured = {}
+    real = mimoreport.Report.figure
+
+    def keep(self, fig, filename, caption):
+        captured[filename] = fig
+        return real(self, fig, filename, caption)
+
+    import unittest.mock as mock
+    with mock.patch.object(mimoreport.Report, "figure", keep):
+        mimoreport.build(res, files=files, inputs=["F1 [N]", "f2 [N]"], outputs=["x1 [m]", "x2 [m]"], w0=W0,
+                         stability=mimoid.stability_of(res.model))
+    e, C = np.asarray(res.residue), np.asarray(res.residue_covariance)
+    for p, ax in enumerate(captured["residues.png"].axes):
+        drawn = ax.get_lines()[0].get_ydata()
+        want = 10 * np.log10(np.abs(e[:, p]) ** 2 / C[:, p, p].real)
+        np.testing.assert_allclose(drawn, want, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(ax.get_lines()[0].get_xdata(), np.asarray(res.lines) * W0, rtol=1e-12)
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "n", "--no-report")
+    assert rc == 0 and not (tmp_path / "n" / "report.html").exists()
+    assert "report.html" not in out

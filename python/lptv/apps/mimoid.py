@@ -7,8 +7,9 @@ period), fitted together into one :class:`lptv.MimoModel` by :func:`lptv.identif
 of (u, y) pairs, u of shape (P, N, nu) and y (P, N, ny) (METHOD.md section 19); ``--joint`` says
 the same and may be given. A single file is one experiment (enough for one input, or when the
 inputs excite different lines). Writes ``model.json`` (:meth:`lptv.MimoModel.load`) and
-``summary.json``, prints the parameters with their standard deviations, the verdict and the
-estimate's stability (its Floquet multipliers); no report.html yet. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4 no verdict,
+``summary.json`` and ``report.html`` (the verdict, the parameters, each output's normalised
+residue, the Floquet multipliers and frozen poles; not with ``--no-report``), prints the
+parameters with their standard deviations, the verdict and the estimate's stability. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4 no verdict,
 2 a file or option that cannot be used (a one-line error), 1 a computation that failed.
 
 Example::
@@ -161,7 +162,14 @@ def run(args) -> int:
         print(f"warning: {msg}")
     summary = json_summary(args, records, w0, ts, ka, kb, res, notes)
     summary["stability"] = {k: v for k, v in stability.items() if k != "text"}
-    failed = write_fit(out, res.model, summary, None)
+    if getattr(args, "no_report", False):
+        report = None
+    else:
+        def report():
+            from lptv.apps.mimoreport import build
+            return build(res, files=files, inputs=list(first.input), outputs=list(first.output), w0=w0,
+                         stability=stability)
+    failed = write_fit(out, res.model, summary, report)
     if failed:
         return _fail(failed[1] if failed[0] is None else f"{failed[0]}: {failed[1]}")
     return status_of(res)
