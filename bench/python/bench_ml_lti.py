@@ -150,7 +150,8 @@ def main():
 
     u, y, d = make_case()
     par = _core.Parametrisation(4, 0, [0] * 5, [0], [], W0, 0.0)
-    kw = dict(na=4, nb=0, lines=LINES, method="sml")
+    # the sample variances: the estimate is compared with _core.estimate's and the other tools'
+    kw = dict(na=4, nb=0, lines=LINES, method="sml", noise="sample")
     est = _core.estimate(d._cpp, par, LINES, method="sml")
     res = lptv.identify(d, **kw)
     eta = np.asarray(est.eta)

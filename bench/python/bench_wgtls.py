@@ -62,12 +62,12 @@ def routes(u, y, w0):
 
     def identify():
         r = lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, method="wgtls",
-                          tol=TOL)
+                          tol=TOL, noise="sample")     # the sample variances, as the routes compared
         return np.asarray(r.theta), r.iterations
 
     def identify_none():
         r = lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, method="wgtls",
-                          tol=TOL, covariance="none")
+                          tol=TOL, covariance="none", noise="sample")
         return np.asarray(r.theta), r.iterations
 
     def core():
@@ -153,7 +153,7 @@ def phases(n: int = 200):
     mod.stability_check = timed("stability check", saved["stability_check"])
     mod._core.identify = timed("_core.identify (estimate, covariance, residues)", saved_core)
     try:
-        call = lambda: lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, tol=TOL)
+        call = lambda: lptv.identify(u, y, na=NA, nb=NB, ka=K, kb=K, w0=w0, lines=LINES, tol=TOL, noise="sample")
         for _ in range(20):
             call()
         spent.clear()
