@@ -2,6 +2,7 @@
 
     python bench/python/bench_mimo.py [--runs 300] [--periods 8] [--level 0.03]
         [--systems 2-in-2-out 1-in-2-out 2-in-1-out] [--methods wgtls sml] [--seed 1]
+        [--noise auto|sample|moderated] [--colour a]
 
 For each system of lptv.mimo_examples (two masses with a periodic coupling spring, 2 inputs and
 2 outputs or 1 input and 2 outputs; one mass with 2 inputs, a periodic input gain and an input
@@ -61,6 +62,17 @@ def setup(system, seed):
     return model, d, us, ys, sy, su
 
 
+def coloured(rng, P, shape, a):
+    """P periods of unit-variance noise of the given (N, channels) shape, white or through
+    1 / (1 - a z^-1) (stationary: the filter runs 200 samples before the first period)."""
+    if not a:
+        return rng.standard_normal((P,) + shape)
+    from scipy.signal import lfilter
+
+    e = rng.standard_normal((P * shape[0] + 200, shape[1])) * np.sqrt(1 - a ** 2)
+    return lfilter([1.0], [1.0, -a], e, axis=0)[200:].reshape((P,) + shape)
+
+
 def run(system, args, out):
     t0 = time.time()
     rng = np.random.default_rng(args.seed)
@@ -68,6 +80,11 @@ def run(system, args, out):
     P, level = args.periods, args.level
     sig_y, sig_u = level * sy, level * su
     noise = np.r_[sig_y ** 2, sig_u ** 2] / N
+    a = args.colour
+    if a:   # every channel's noise through 1 / (1 - a z^-1), its rms kept: the lines' variances follow
+        lines = np.arange(N // 2 + 1)
+        shape = (1 - a ** 2) / np.abs(1 - a * np.exp(-2j * np.pi * lines / N)) ** 2
+        noise = shape[:, None] * noise[None, :]
     s = RIGHT[system]
     bound = lptv.mimo_crb(model, d.spectra, noise=noise, periods=P, ka=s["ka"], kb=s["kb"])
     truth = bound.eta
@@ -76,36 +93,46 @@ def run(system, args, out):
     var = {m: [] for m in args.methods}
     ok = {m: [] for m in args.methods}
     power = {k: [] for k in wrong(system)}
+    refused = {k: 0 for k in wrong(system)}
     fails = 0
+    routes = []
     for r in range(args.runs):
         pairs = []
         for u1, y1 in zip(us, ys):
-            u = u1[None] + sig_u * rng.standard_normal((P,) + u1.shape)
-            y = y1[None] + sig_y * rng.standard_normal((P,) + y1.shape)
+            u = u1[None] + sig_u * coloured(rng, P, u1.shape, a)
+            y = y1[None] + sig_y * coloured(rng, P, y1.shape, a)
             pairs.append((u, y))
         fit_data = pairs
         if args.known_noise:   # the true covariance of the means instead of the periods' sample one
-            C = np.diag(noise.astype(complex)) / P
-            fit_data = [dataclasses.replace(lptv.MimoFrequencyData.from_periods(u, y, w0=mx.W0),
-                                            C=np.broadcast_to(C, (N // 2 + 1,) + C.shape).copy()) for u, y in pairs]
+            nz = np.broadcast_to(noise, (N // 2 + 1, noise.shape[-1])).astype(complex)
+            C = np.einsum("lc,cd->lcd", nz, np.eye(nz.shape[1])) / P
+            fit_data = [dataclasses.replace(lptv.MimoFrequencyData.from_periods(u, y, w0=mx.W0), C=C.copy())
+                        for u, y in pairs]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
                 for m in args.methods:
-                    res = lptv.identify(fit_data, w0=mx.W0, method=m, **s)
+                    res = lptv.identify(fit_data, w0=mx.W0, method=m, noise=args.noise, **s)
+                    routes.append(res.noise)
                     est[m].append(res.eta)
                     var[m].append(res.parameter_std ** 2)
                     ok[m].append(res.model_ok)
-                for k, st in wrong(system).items():
-                    res = lptv.identify(fit_data, w0=mx.W0, method=args.verdict_method, covariance="none", **st)
-                    power[k].append(not res.model_ok)
             except ValueError as err:
                 fails += 1
                 print(f"  run {r}: {err}", file=sys.stderr)
+                continue
+            for k, st in wrong(system).items():
+                try:
+                    res = lptv.identify(fit_data, w0=mx.W0, method=args.verdict_method, covariance="none",
+                                        noise=args.noise, **st)
+                    power[k].append(not res.model_ok)
+                except ValueError:     # the wrong structure cannot be fitted: refused, counted apart
+                    refused[k] += 1
     names = np.array(bound.parameter_names)
     print(f"\n## {system}: {model.n_inputs} in, {model.n_outputs} out; E = {d.n_experiments} Hadamard experiments, "
           f"N = {N}, lines {LINES[0]}..{LINES[-1]} step {LINES[1] - LINES[0]}, P = {P}, noise {level:g} x rms on "
-          f"every channel; {args.runs} runs ({fails} failed), {len(free)} free parameters; "
+          f"every channel{f' coloured by 1/(1 - {a:g} z^-1)' if a else ''}; {args.runs} runs ({fails} failed), {len(free)} free parameters; "
+          f"noise={args.noise} (fits on the moderated route: {routes.count('moderated')} of {len(routes)}); "
           f"{time.time() - t0:.0f} s", file=out)
     z = 1.959963984540054
     for m in args.methods:
@@ -134,7 +161,8 @@ def run(system, args, out):
         print(f"         verdict on the right structure: rejects {100 * rej:.1f} % of {n} "
               f"(+- {100 * np.sqrt(max(rej, 0.01) * (1 - rej) / n):.1f}; size goal 1 %)", file=out)
     for k, v in power.items():
-        print(f"  verdict ({args.verdict_method}) against a {k}: rejects {100 * np.mean(v):.1f} % of {len(v)}", file=out)
+        print(f"  verdict ({args.verdict_method}) against a {k}: rejects {100 * np.mean(v):.1f} % of {len(v)}"
+              + (f" (and {refused[k]} fits refused with a ValueError)" if refused[k] else ""), file=out)
     out.flush()
 
 
@@ -147,12 +175,17 @@ def main(argv=None):
     ap.add_argument("--methods", nargs="+", default=["wgtls", "sml"], choices=["wgtls", "sml"])
     ap.add_argument("--verdict-method", default="wgtls", choices=["wgtls", "sml"])
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--colour", type=float, default=0.0,
+                    help="noise through 1 / (1 - a z^-1) on every channel (0: white)")
+    ap.add_argument("--noise", default="auto", choices=["auto", "sample", "moderated"],
+                    help="lptv.identify's noise route (auto: moderated when the noise spectrum is smooth)")
     ap.add_argument("--known-noise", action="store_true",
                     help="fit with the true noise covariance of the means (not the periods' sample one): "
                          "separates the loss of the sample covariances from the estimator's")
     args = ap.parse_args(argv)
     print(f"bench_mimo.py --runs {args.runs} --periods {args.periods} --level {args.level} --systems "
-          f"{' '.join(args.systems)} --methods {' '.join(args.methods)} --seed {args.seed}"
+          f"{' '.join(args.systems)} --methods {' '.join(args.methods)} --seed {args.seed} --noise {args.noise}"
+          + (f" --colour {args.colour:g}" if args.colour else "")
           + (" --known-noise" if args.known_noise else ""))
     for system in args.systems:
         run(system, args, sys.stdout)

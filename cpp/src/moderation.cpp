@@ -92,8 +92,10 @@ constexpr long long kShapeWidth = 2;
 // (|j - i| <= W, j != i, keep[j]) into the trend's value at i, and v[i], the variance of log
 // k[i]. The trend z_j = alpha + beta x + c x^2 (x = j - i) is fitted by least squares to the
 // log variances z over |x| <= kShapeWidth W (j != i, ok[j]); k = 1 / mean_j exp(beta x_j +
-// c x_j^2 - q_j / 2), q_j the fitted shape's variance at x_j. Fewer than W points on either side
-// of i within the fit's window, or a singular fit: k = 1, v = 0. The reference's _shape.
+// c x_j^2 - q_j / 2), q_j the fitted shape's variance at x_j. Near the first and last lines the
+// window holds the lines on one side only and the trend is extrapolated to i (its variance
+// enters v). Fewer than 2 W points in the window, or a singular fit: k = 1, v = 0. The
+// reference's _shape.
 void shape_factors(const Eigen::VectorXd& z, const std::vector<char>& ok, const std::vector<char>& keep,
                    long long W, double var_log, Eigen::VectorXd& k, Eigen::VectorXd& v) {
   const Eigen::Index m = z.size();
@@ -107,7 +109,7 @@ void shape_factors(const Eigen::VectorXd& z, const std::vector<char>& ok, const 
       if (i + x < m && ok[i + x]) ++right[i];
     }
   for (Eigen::Index i = 0; i < m; ++i) {
-    if (left[i] < W || right[i] < W) continue;
+    if (left[i] + right[i] < 2 * W) continue;
     double C[5] = {0, 0, 0, 0, 0}, T[3] = {0, 0, 0};
     for (long long x = -S; x <= S; ++x) {
       const long long j = i + x;
@@ -385,6 +387,145 @@ ModeratedNoise moderated_noise(const FrequencyData& data, int half_width) {
   for (Eigen::Index l = 0; l <= L; ++l) {
     const double a = std::abs(mod.covYU[l]), uy = mod.varU[l] * mod.varY[l];
     if (a * a > uy) mod.covYU[l] *= std::sqrt(uy) / a;
+  }
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (outlier[i]) out.outliers.push_back(static_cast<int>(i + 1));
+  out.prior_dof = d0;
+  out.moderated = true;
+  return out;
+}
+
+ModeratedCovariances moderated_covariances(const Eigen::MatrixXcd& C, int n_outputs, int periods, int half_width) {
+  const Eigen::Index c = C.cols();
+  if (c < 2) throw std::invalid_argument("C must have at least 2 columns (channels), got " + std::to_string(c));
+  if (C.rows() < c || C.rows() % c != 0)
+    throw std::invalid_argument("C must have (L+1) c rows for c = " + std::to_string(c) + " channels, got " +
+                                std::to_string(C.rows()));
+  if (n_outputs < 1 || n_outputs >= c)
+    throw std::invalid_argument("n_outputs must be within 1.." + std::to_string(c - 1) + ", got " +
+                                std::to_string(n_outputs));
+  if (periods < 0) throw std::invalid_argument("periods must be >= 0, got " + std::to_string(periods));
+  if (half_width < 1) throw std::invalid_argument("half_width must be >= 1, got " + std::to_string(half_width));
+  if (!C.allFinite()) throw std::invalid_argument("C must be finite");
+  const long long W = half_width;
+  const int P = periods;
+  const int L = static_cast<int>(C.rows() / c) - 1;
+  ModeratedCovariances out;
+  out.covariance = C;
+  out.half_width = half_width;
+  const double own = P >= 2 ? 2.0 * (P - 1) : kInf;
+  out.dof = Eigen::VectorXd::Constant(L + 1, own);
+  if (P >= 2) out.dof[0] = out.dof[L] = P - 1.0;
+  out.own_weight = Eigen::VectorXd::Ones(L + 1);
+  out.neighbour = Eigen::Matrix<bool, Eigen::Dynamic, 1>::Constant(L + 1, false);
+  if (P < 2 || L < 3 * W + 2) return out;
+
+  const double d = own;
+  const Eigen::Index m = L - 1;  // the inner lines 1..L-1, index i for line i + 1
+  const double mean_log = digamma(d / 2) - std::log(d / 2);
+  const double var_log = trigamma(d / 2);
+  // every channel's variances on the inner lines, inputs first (the pair (u, y) of one channel each)
+  std::vector<Eigen::VectorXd> var;
+  for (Eigen::Index k = 0; k < c; ++k) {
+    const Eigen::Index q = (k + n_outputs) % c;
+    Eigen::VectorXd v(m);
+    for (Eigen::Index i = 0; i < m; ++i) v[i] = C((i + 1) * c + q, q).real();
+    var.push_back(std::move(v));
+  }
+  std::vector<const Eigen::VectorXd*> channels;
+  for (const Eigen::VectorXd& v : var)
+    if ((v.array() > 0).count() >= 3 * W) channels.push_back(&v);
+  if (channels.empty()) return out;
+
+  std::vector<char> outlier(m, 0), ok(m);
+  std::map<int, double> quantile;
+  Eigen::VectorXd s;
+  Eigen::VectorXi n;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const Eigen::VectorXd* v : channels) {
+      for (Eigen::Index i = 0; i < m; ++i) ok[i] = (*v)[i] > 0 && !outlier[i];
+      window_sums(*v, ok, W, s, n);
+      for (Eigen::Index i = 0; i < m; ++i) {
+        if (n[i] <= 0) continue;
+        auto q = quantile.find(n[i]);
+        if (q == quantile.end())
+          q = quantile.emplace(n[i], f_upper_quantile(kModerationOutlierRate, d, n[i] * d)).first;
+        if ((*v)[i] > q->second * (s[i] / n[i])) outlier[i] = 1;
+      }
+    }
+  }
+  std::vector<double> r2;
+  for (const Eigen::VectorXd* v : channels) {
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      ok[i] = (*v)[i] > 0 && !outlier[i];
+      if (ok[i]) z[i] = std::log((*v)[i]) - mean_log;
+    }
+    window_sums(z, ok, W, s, n);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (!ok[i] || n[i] < W) continue;
+      const double r = z[i] - s[i] / n[i];
+      r2.push_back(r * r / (1.0 + 1.0 / n[i]));
+    }
+  }
+  if (static_cast<long long>(r2.size()) < 3 * W) return out;
+  double sum = 0.0;
+  for (double r : r2) sum += r;
+  const double excess = sum / static_cast<double>(r2.size()) - var_log;
+  const double d0 = excess <= 0 ? kModerationMaxPriorDof
+                                : std::min(2.0 * trigamma_inverse(excess), kModerationMaxPriorDof);
+
+  std::vector<char> keep(m);
+  for (Eigen::Index i = 0; i < m; ++i) keep[i] = !outlier[i];
+  const double scale = std::max(d0 - 2.0, 0.0) / d0;
+  const double w = d / (d + d0);
+  // each channel's shape factor (in C's channel order) and the largest variance of its log
+  Eigen::MatrixXd k = Eigen::MatrixXd::Ones(m, c);
+  Eigen::VectorXd vk = Eigen::VectorXd::Zero(m);
+  for (Eigen::Index q = 0; q < c; ++q) {
+    std::vector<char> okv(m);
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
+    long long count = 0;
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const double vi = C((i + 1) * c + q, q).real();
+      okv[i] = vi > 0 && keep[i];
+      if (okv[i]) {
+        z[i] = std::log(vi) - mean_log;
+        ++count;
+      }
+    }
+    if (count < 3 * W) continue;
+    Eigen::VectorXd kq, vq;
+    shape_factors(z, okv, keep, W, var_log, kq, vq);
+    k.col(q) = kq;
+    vk = vk.cwiseMax(vq);
+  }
+  // the neighbours' sums of every entry (real and imaginary parts as the reference sums them)
+  std::vector<Eigen::VectorXd> sr(c * c), si(c * c);
+  Eigen::VectorXd xr(m), xi(m);
+  for (Eigen::Index p = 0; p < c; ++p)
+    for (Eigen::Index q = 0; q < c; ++q) {
+      for (Eigen::Index i = 0; i < m; ++i) {
+        xr[i] = C((i + 1) * c + p, q).real();
+        xi[i] = C((i + 1) * c + p, q).imag();
+      }
+      window_sums(xr, keep, W, sr[p * c + q], n);
+      window_sums(xi, keep, W, si[p * c + q], n);
+    }
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const Eigen::Index l = i + 1;
+    if (keep[i]) out.neighbour[l] = true;
+    if (!keep[i] || n[i] <= 0) continue;
+    const double a = (1.0 - w) * scale / static_cast<double>(n[i]);
+    for (Eigen::Index p = 0; p < c; ++p)
+      for (Eigen::Index q = 0; q < c; ++q) {
+        const double kk = std::sqrt(k(i, p) * k(i, q));
+        out.covariance(l * c + p, q) =
+            w * C(l * c + p, q) + a * kk * std::complex<double>(sr[p * c + q][i], si[p * c + q][i]);
+      }
+    const double nn = n[i];
+    out.dof[l] = (d + d0) * (d + d0) / (d + d0 + d0 * d0 * (1.0 / (nn * d) + vk[i] / 2.0));
+    out.own_weight[l] = w;
   }
   for (Eigen::Index i = 0; i < m; ++i)
     if (outlier[i]) out.outliers.push_back(static_cast<int>(i + 1));

@@ -39,6 +39,41 @@ Returns
 -------
 ModeratedNoise
 )doc");
+  py::class_<lptv::ModeratedCovariances>(
+      m, "ModeratedCovariances",
+      "Covariance matrices of several channels moderated across neighbouring lines (lptv::moderated_covariances).")
+      .def_readonly("covariance", &lptv::ModeratedCovariances::covariance)
+      .def_readonly("dof", &lptv::ModeratedCovariances::dof)
+      .def_readonly("prior_dof", &lptv::ModeratedCovariances::prior_dof)
+      .def_readonly("outliers", &lptv::ModeratedCovariances::outliers)
+      .def_readonly("half_width", &lptv::ModeratedCovariances::half_width)
+      .def_readonly("moderated", &lptv::ModeratedCovariances::moderated)
+      .def_readonly("own_weight", &lptv::ModeratedCovariances::own_weight)
+      .def_readonly("neighbour", &lptv::ModeratedCovariances::neighbour);
+  m.def(
+      "moderated_covariances",
+      [](const Eigen::MatrixXcd& C, int n_outputs, int periods, int half_width) {
+        py::gil_scoped_release release;
+        return lptv::moderated_covariances(C, n_outputs, periods, half_width);
+      },
+      "C"_a, "n_outputs"_a, "periods"_a, "half_width"_a,
+      R"doc(The covariance matrices of the means of c channels (outputs first) moderated across lines.
+
+Parameters
+----------
+C : complex array, shape ((L+1) c, c)
+    Rows l c .. l c + c - 1: the covariance matrix of the mean [Y_l; U_l] on line l.
+n_outputs : int
+    ny, 1..c-1.
+periods : int
+    P (returned unchanged below 2).
+half_width : int
+    The neighbours of a line: the lines within +-half_width (>= 1).
+
+Returns
+-------
+ModeratedCovariances
+)doc");
   m.def("digamma", &lptv::digamma, "x"_a, "The digamma function psi(x), x > 0.");
   m.def("trigamma", &lptv::trigamma, "x"_a, "The trigamma function psi'(x), x > 0.");
   m.def("tetragamma", &lptv::tetragamma, "x"_a, "The tetragamma function psi''(x), x > 0.");

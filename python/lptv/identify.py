@@ -247,13 +247,10 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     (2, [[2.0, 0.5], [0.0, 3.0]], True)
     """
     if is_mimo(u, y):
-        # noise='auto' takes each line's own sample (co)variances here: no moderation is built
-        # for several channels (METHOD.md section 19)
-        if noise not in ("auto", "sample") or disturbances is not None:
-            raise ValueError("noise and disturbances: only noise='auto' or 'sample' (each line's own sample "
-                             "(co)variances) and disturbances=None are built for several inputs or outputs")
+        if disturbances is not None:
+            raise ValueError("disturbances: only disturbances=None is built for several inputs or outputs")
         return identify_mimo(u, y, na=na, nb=nb, ka=ka, kb=kb, w0=w0, ts=ts, lines=lines, method=method,
-                             known=known, tol=tol, max_iter=max_iter, covariance=covariance)
+                             known=known, tol=tol, max_iter=max_iter, covariance=covariance, noise=noise)
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if not isinstance(covariance, str) or covariance not in COVARIANCES:

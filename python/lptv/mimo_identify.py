@@ -12,10 +12,40 @@ import numpy as np
 from ._validate import _array, as_float, as_int, as_lines, check_finite
 from .mimo import MimoModel
 from .mimo_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
-from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit
+from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
 from .mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
+AUTO_MIN_PERIODS = 4
+"""noise='auto' moderates from this many periods (as for one input and output)."""
+
+
+def _noise_route(datas, noise):
+    """(route, why, the MimoModeratedNoise per experiment or None) for noise='auto', 'sample' or
+    'moderated' (METHOD.md section 19, "Moderated noise for several channels")."""
+    from .moderation import smooth_noise
+    from .mimo_moderation import moderated_mimo_noise
+
+    if noise == "sample":
+        return "sample", "asked for", None
+    if noise == "moderated":
+        mos = [moderated_mimo_noise(d) for d in datas]
+        if any(m.prior_dof <= 0 for m in mos):
+            return "sample", ("the sample (co)variances: they cannot be moderated (too few lines with noise, "
+                              "or not from periods)"), None
+        return "moderated", "asked for", mos
+    mos, why = [], []
+    for d in datas:
+        if d.periods < AUTO_MIN_PERIODS:
+            return "sample", (f"the sample (co)variances: {d.periods} periods (the moderated route needs "
+                              f"{AUTO_MIN_PERIODS})"), None
+        mo = moderated_mimo_noise(d)
+        ok, reason = smooth_noise(mo)
+        if not ok:
+            return "sample", "the sample (co)variances: " + reason, None
+        mos.append(mo)
+        why.append(reason)
+    return "moderated", "moderated: " + "; ".join(why), mos
 
 
 def is_mimo(u, y) -> bool:
@@ -121,8 +151,11 @@ def _known_leading(known, na, ny):
 
 
 def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None, method="wgtls",
-                  known=None, tol=1e-10, max_iter=50, covariance="analytic") -> MimoIdentificationResult:
+                  known=None, tol=1e-10, max_iter=50, covariance="analytic",
+                  noise="auto") -> MimoIdentificationResult:
     """lptv.identify's route for several inputs or outputs (its docstring has the arguments)."""
+    if not isinstance(noise, str) or noise not in ("auto", "sample", "moderated"):
+        raise ValueError(f"noise must be one of ('auto', 'sample', 'moderated'), got {noise!r}")
     if not isinstance(method, str) or method not in MIMO_METHODS:
         raise ValueError(f"method must be one of {MIMO_METHODS} for several inputs or outputs, got {method!r}")
     if not isinstance(covariance, str) or covariance not in ("analytic", "none"):
@@ -131,6 +164,9 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=1)
     datas = _experiments(u, y, w0, ts)
+    route, choice, mos = _noise_route(datas, noise)
+    if route == "moderated":
+        datas = [m.data for m in mos]
     d0 = datas[0]
     ny, nu = d0.n_outputs, d0.n_inputs
     lead = _known_leading(known, na, ny)
@@ -148,6 +184,10 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters")
     P = np.array([d.periods for d in datas])
     noisy = any(np.max(np.abs(d.C)) > 0 for d in datas)
+    # the periods the (co)variances are worth: P, or 1 + dof / 2 of the moderated ones (the
+    # median over the inner lines for the covariance's factor, each row's own for its tests)
+    Pcov = P if mos is None else np.array([max(int(d.periods), int(round(1.0 + float(np.median(m.dof[1:-1])) / 2.0)))
+                                           for d, m in zip(datas, mos)])
     if noisy and ny > 1 and P.min() <= ny:
         raise ValueError(f"u, y: P = {int(P.min())} periods give residue covariances of rank at most P - 1 < ny = "
                          f"{ny} (complex Wishart, METHOD.md section 19): several outputs need P > ny periods")
@@ -173,7 +213,7 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         cost = float(np.sum(q)) / n_scalar
     cov, factor = None, 1.0
     if free_cov is not None:
-        Pmin = int(P.min())
+        Pmin = int(Pcov.min())
         # (P-1)/(P-3) for every ny, calibrated by Monte Carlo (METHOD.md section 19): the
         # (P-1)/(P-2-ny) of the Wishart argument over-covers at ny = 2 (97.7 % at P = 8)
         if Pmin >= 4:
@@ -184,6 +224,11 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         cov = factor * expand(free_cov, st)
     for msg in warns:
         warnings.warn(msg, UserWarning, stacklevel=3)
+    if lead is None:      # the normalised entries exactly (the core sets them through A_na,0^-1)
+        fixed = np.setdiff1d(np.arange(xi.size), st.free)
+        xi = xi.copy()
+        xi[fixed] = np.round(xi[fixed])
+    xi_fit = xi
     if lead is not None:
         # the model with A_na,0 = M is M times the one with A_na,0 = I (the same system)
         Kx = np.kron(lead, np.eye(st.n_row))
@@ -193,15 +238,24 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         Ce = np.einsum("pi,rij,qj->rpq", lead, Ce, lead)
     a, b = st.coefficients(xi)
     model = MimoModel(a, b, w0=d0.w0, ts=d0.ts)
-    row_P = np.concatenate([np.full(r.size, p) for r, p in zip(rows_list, P)])
-    tests = () if noise_free else residue_tests(res, Ce, row_P)
+    if mos is None:
+        row_P = np.concatenate([np.full(r.size, p) for r, p in zip(rows_list, P)])
+        Cv = Ce
+    else:
+        # the verdict divides by the moderated covariances with the prior's part at the
+        # neighbours' mean itself (section 7, "The verdict's scale"), each row worth its line's dof
+        row_P = np.concatenate([m.periods[r] for r, m in zip(rows_list, mos)])
+        _, Cv = residues(core_data([m.unbiased_data() for m in mos], rows_list), cst, xi_fit)
+        if lead is not None:
+            Cv = np.einsum("pi,rij,qj->rpq", lead, Cv, lead)
+    tests = () if noise_free else residue_tests(res, Cv, row_P)
     return MimoIdentificationResult(
         model=model, method=method, eta=xi, parameter_names=st.names, covariance=cov, converged=bool(converged),
         cost=float(cost), lines=np.concatenate(rows_list), experiment=np.concatenate(
             [np.full(r.size, e) for e, r in enumerate(rows_list)]), residue=res, residue_covariance=Ce,
         periods=tuple(int(p) for p in P), iterations=int(iters), singular_values=np.asarray(sv),
         n_free_parameters=int(st.free.size), noise_free=bool(noise_free), covariance_factor=float(factor),
-        warnings=tuple(warns), tests=tests)
+        warnings=tuple(warns), tests=tests, noise=route, noise_choice=choice, moderation=tuple(mos or ()))
 
 
 @dataclass(frozen=True)

@@ -54,6 +54,13 @@ class MimoIdentificationResult:
     warnings: Tuple[str, ...] = ()
     tests: Tuple = field(default=(), repr=False)
     """(row index, output or -1 for the joint test, statistic, p-value) of each residue test."""
+    noise: str = "sample"
+    """The noise (co)variances the fit weighed by: 'sample' (each line's own) or 'moderated'
+    (combined with the neighbouring lines', METHOD.md section 19)."""
+    noise_choice: str = ""
+    """Why: 'asked for', or the smoothness check's sentence for noise='auto'."""
+    moderation: Tuple = field(default=(), repr=False)
+    """The :class:`lptv.mimo_moderation.MimoModeratedNoise` of each experiment (moderated route)."""
 
     @property
     def n_inputs(self) -> int:

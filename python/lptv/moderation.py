@@ -127,8 +127,11 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
 
     Parameters
     ----------
-    data : lptv.FrequencyData
-        Spectra and noise statistics from P >= 2 periods.
+    data : lptv.FrequencyData or lptv.MimoFrequencyData
+        Spectra and noise statistics from P >= 2 periods. For several channels the whole
+        covariance matrix of the outputs and inputs on a line is moderated with one weight
+        (METHOD.md section 19, "Moderated noise for several channels"), d0 from every channel's
+        variances, and a :class:`lptv.mimo_moderation.MimoModeratedNoise` is returned.
     half_width : int
         The neighbours of a line: the lines within +-half_width (default 10). Wider windows
         moderate more but follow a changing noise spectrum less closely (the estimated d0 then
@@ -151,9 +154,14 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     (43, 37)
     """
     from .data import FrequencyData
+    from .mimo_data import MimoFrequencyData
 
+    if isinstance(data, MimoFrequencyData):
+        from .mimo_moderation import moderated_mimo_noise
+
+        return moderated_mimo_noise(data, half_width)
     if not isinstance(data, FrequencyData):
-        raise ValueError(f"data must be an lptv.FrequencyData, got {type(data).__name__}")
+        raise ValueError(f"data must be an lptv.FrequencyData or lptv.MimoFrequencyData, got {type(data).__name__}")
     W = as_int(half_width, "half_width", minimum=1, maximum=10**6)
     core = _core.moderated_noise(data._cpp, W)
     vu, vy = data.varU, data.varY
@@ -224,7 +232,8 @@ def _lag_correlation(mo: ModeratedNoise):
     if np.size(mo.outliers):
         keep[np.asarray(mo.outliers, int) - 1] = False
     worst, pairs = -1.0, 0
-    for v in (mo.source_varU, mo.source_varY):
+    channels = mo.channel_variances if hasattr(mo, "channel_variances") else (mo.source_varU, mo.source_varY)
+    for v in channels:
         if v is None:
             continue
         v = np.asarray(v, float)[1:-1]
@@ -253,7 +262,7 @@ def smooth_noise(mo: ModeratedNoise):
     lines kept their own variance (a spectrum of many narrow peaks is not smooth), and the
     residuals of neighbouring lines' log variances about their local quadratic trend (over
     +-2 half_width lines, the line itself left out) do not correlate beyond
-    ``SMOOTH_LAG_SIGMAS`` standard errors, in the input or the output (a spectrum of bumps a few
+    ``SMOOTH_LAG_SIGMAS`` standard errors, in the input or the output (in any channel of several; a spectrum of bumps a few
     lines wide, which the trend cannot follow and the moderation would smear, is not smooth;
     for scatter about a smooth trend the residuals of neighbours are independent).
 
@@ -267,8 +276,11 @@ def smooth_noise(mo: ModeratedNoise):
     >>> ok
     True
     """
-    if not isinstance(mo, ModeratedNoise):
-        raise ValueError(f"mo must be an lptv.ModeratedNoise, got {type(mo).__name__}")
+    from .mimo_moderation import MimoModeratedNoise
+
+    if not isinstance(mo, (ModeratedNoise, MimoModeratedNoise)):
+        raise ValueError(f"mo must be an lptv.ModeratedNoise (or the MimoModeratedNoise of several channels), "
+                         f"got {type(mo).__name__}")
     P = int(mo.data.periods)
     d = 2.0 * (P - 1)
     d0 = float(mo.prior_dof)

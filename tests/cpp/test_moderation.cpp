@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <complex>
 #include <stdexcept>
 #include <utility>
@@ -117,10 +119,11 @@ lptv::FrequencyData constant_noise(int L, int P, double vu, double vy, std::comp
 // The shape factor (k, v) of inner line i (0-based, m inner lines) for log variances exactly
 // constant: the fitted shape is zero and k = n / sum_j exp(-q_j / 2) with q_j the fit's variance
 // at x_j from the window's geometry alone (METHOD.md section 7, "the spectrum's shape"); k = 1,
-// v = 0 with fewer than W lines on either side within +-2 W.
+// v = 0 with fewer than 2 W lines within +-2 W (near the first and last lines the window is
+// one-sided and the trend extrapolated).
 std::pair<double, double> flat_shape(int i, int m, int W, double var_log) {
   const int S = 2 * W;
-  if (std::min(i, S) < W || std::min(m - 1 - i, S) < W) return {1.0, 0.0};
+  if (std::min(i, S) + std::min(m - 1 - i, S) < 2 * W) return {1.0, 0.0};
   double C[5] = {0, 0, 0, 0, 0};
   for (int x = -S; x <= S; ++x) {
     if (x == 0 || i + x < 0 || i + x >= m) continue;
@@ -163,7 +166,7 @@ TEST_CASE("Moderation: variances exactly as smooth as their trend", "[moderation
     const double n = std::min(l - 1, W) + std::min(L - 1 - l, W);
     const auto [k, vk] = flat_shape(l - 1, L - 1, W, lptv::trigamma(d / 2));
     if (l == 50) CHECK(k > 1.0);                  // the fit's noise taken out of a flat shape
-    if (l == 1) CHECK(k == 1.0);                  // the first lines: no shape factor
+    if (l == 1) CHECK(k > 1.0);                   // the first line too: the trend extrapolated by one line
     const double want = w * 0.04 + (1 - w) * (d0 - 2) / d0 * k * 0.04;
     // The neighbours' sums come from running sums over the lines (L v at most against 2 W v).
     CHECK(std::abs(mod.data.varY[l] - want) <= 1e-13 * want);
@@ -220,4 +223,58 @@ TEST_CASE("Moderation: data that cannot be moderated come back unchanged", "[mod
   auto bad = constant_noise(100, 4, 0.01, 0.01, {});
   bad.varY[3] = -1.0;
   CHECK_THROWS_AS(lptv::moderated_noise(bad, 10), std::invalid_argument);
+}
+
+TEST_CASE("Moderation of several channels: two channels are the single-channel moderation", "[moderation]") {
+  // Variances that scatter about a sloping trend (a deterministic pattern, no random numbers),
+  // a spike on the output: the matrix [[varY, covYU], [conj covYU, varU]] per line moderates
+  // exactly as the pair.
+  const int L = 120, P = 4;
+  lptv::FrequencyData d = constant_noise(L, P, 0.01, 0.04, {0.002, 0.001});
+  for (int l = 0; l <= L; ++l) {
+    d.varU[l] *= std::exp(-0.01 * l + 0.4 * std::sin(1.7 * l));
+    d.varY[l] *= std::exp(0.02 * l + 0.5 * std::cos(2.3 * l));
+  }
+  d.varY[60] *= 50.0;
+  const auto one = lptv::moderated_noise(d, 8);
+  Eigen::MatrixXcd C(2 * (L + 1), 2);
+  for (int l = 0; l <= L; ++l) {
+    C(2 * l, 0) = d.varY[l];
+    C(2 * l, 1) = d.covYU[l];
+    C(2 * l + 1, 0) = std::conj(d.covYU[l]);
+    C(2 * l + 1, 1) = d.varU[l];
+  }
+  const auto two = lptv::moderated_covariances(C, 1, P, 8);
+  REQUIRE(one.moderated);
+  REQUIRE(two.moderated);
+  CHECK(two.prior_dof == one.prior_dof);
+  CHECK(two.outliers == one.outliers);
+  CHECK(std::find(two.outliers.begin(), two.outliers.end(), 60) != two.outliers.end());
+  for (int l = 0; l <= L; ++l) {
+    INFO("line " << l);
+    CHECK(std::abs(two.covariance(2 * l, 0).real() - one.data.varY[l]) <= 1e-14 * one.data.varY[l]);
+    CHECK(std::abs(two.covariance(2 * l + 1, 1).real() - one.data.varU[l]) <= 1e-14 * one.data.varU[l]);
+    CHECK(std::abs(two.covariance(2 * l, 1) - one.data.covYU[l]) <= 1e-14 * std::sqrt(one.data.varU[l] * one.data.varY[l]));
+    CHECK(two.dof[l] == one.dof[l]);
+    CHECK(two.own_weight[l] == one.own_weight[l]);
+  }
+}
+
+TEST_CASE("Moderation of several channels: bad arguments throw, too few lines come back unchanged", "[moderation]") {
+  const Eigen::MatrixXcd C = Eigen::MatrixXcd::Identity(3, 3).replicate(41, 1);   // 41 lines, 3 channels
+  CHECK_THROWS_AS(lptv::moderated_covariances(C, 0, 4, 10), std::invalid_argument);
+  CHECK_THROWS_AS(lptv::moderated_covariances(C, 3, 4, 10), std::invalid_argument);
+  CHECK_THROWS_AS(lptv::moderated_covariances(C, 2, -1, 10), std::invalid_argument);
+  CHECK_THROWS_AS(lptv::moderated_covariances(C, 2, 4, 0), std::invalid_argument);
+  CHECK_THROWS_AS(lptv::moderated_covariances(C.topRows(121), 2, 4, 10), std::invalid_argument);
+  Eigen::MatrixXcd bad = C;
+  bad(5, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(lptv::moderated_covariances(bad, 2, 4, 10), std::invalid_argument);
+  const auto few = lptv::moderated_covariances(C.topRows(3 * 31), 2, 4, 10);   // Lmax = 30 < 32
+  CHECK_FALSE(few.moderated);
+  CHECK(few.prior_dof == 0.0);
+  CHECK(few.covariance == C.topRows(3 * 31));
+  const auto flat = lptv::moderated_covariances(C, 2, 4, 10);                   // exactly flat: d0 at its cap
+  CHECK(flat.moderated);
+  CHECK(flat.prior_dof == lptv::kModerationMaxPriorDof);
 }

@@ -259,3 +259,23 @@ def test_the_report_shows_the_verdict_the_parameters_and_each_output_s_residue(e
     rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "n", "--no-report")
     assert rc == 0 and not (tmp_path / "n" / "report.html").exists()
     assert "report.html" not in out
+
+
+@needs_fit
+@pytest.mark.parametrize("noise", ["sample", "moderated"])
+def test_noise_option_gives_the_api_route(noise, experiments, files, tmp_path, capsys):
+    """--noise takes lptv.identify's noise route for several channels too, and says it (the
+    moderated route itself: test_mimo_moderation.py)."""
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--noise", noise, "--out", tmp_path / "o")
+    assert rc == 0, out + err
+    res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0, noise=noise)
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["noise"] == res.noise == noise
+    assert summary["noise_choice"] == res.noise_choice == "asked for"
+    assert f"noise (co)variances: {noise} (asked for)" in out
+    model = lptv.MimoModel.load(tmp_path / "o" / "model.json")
+    np.testing.assert_allclose(model.a, res.model.a, rtol=0, atol=1e-10 * np.abs(res.model.a).max())
+    # the normalised entries are written exactly (A_2,0 = I)
+    names = [p["name"] for p in summary["parameters"]]
+    values = {p["name"]: p["value"] for p in summary["parameters"]}
+    assert [values[n] for n in names if n.startswith("a2[") and n.endswith(".re0")] == [1.0, 0.0, 0.0, 1.0]

@@ -172,8 +172,8 @@ def test_one_by_one_equals_siso(method, seed):
     u = ms.periods(P) + 0.02 * rng.standard_normal((P, 128))
     y = np.tile(y1, (P, 1)) + 0.02 * rng.standard_normal((P, 128))
     kw = dict(na=1, nb=0, ka=1, kb=0, w0=1.0, method=method, tol=1e-13, max_iter=200)
-    siso = lptv.identify(u, y, **kw, noise="sample")      # the MIMO fit weighs by the sample variances
-    mimo = lptv.identify(u[:, :, None], y[:, :, None], **kw)
+    siso = lptv.identify(u, y, **kw, noise="sample")      # both on the sample variances (the moderated
+    mimo = lptv.identify(u[:, :, None], y[:, :, None], **kw, noise="sample")   # route: test_mimo_moderation.py)
     assert isinstance(mimo, lptv.MimoIdentificationResult)
     assert mimo.model.n_inputs == mimo.model.n_outputs == 1
     assert np.abs(mimo.eta - siso.eta).max() <= 1e-8 * np.abs(siso.eta).max() + 1e-6 * siso.parameter_std.min()

@@ -48,6 +48,29 @@ struct ModeratedNoise {
 // do not validate.
 ModeratedNoise moderated_noise(const FrequencyData& data, int half_width);
 
+// The moderated covariance matrices of several channels (METHOD.md section 19, "Moderated noise
+// for several channels").
+struct ModeratedCovariances {
+  Eigen::MatrixXcd covariance;   // (L+1) c x c: rows l c .. l c + c - 1 the matrix of line l
+  Eigen::VectorXd dof;           // per line, as ModeratedNoise::dof
+  double prior_dof = 0.0;        // d0 (0: not moderated)
+  std::vector<int> outliers;     // lines that kept their own matrix (outlying in some channel)
+  int half_width = 0;
+  bool moderated = false;        // false: covariance is the input unchanged
+  Eigen::VectorXd own_weight;    // per line: d / (d + d0) (1 where kept)
+  Eigen::Matrix<bool, Eigen::Dynamic, 1> neighbour;  // per line: may serve as a neighbour
+};
+
+// Section 7's rule for the covariance matrices C_l of the means of c channels (outputs 0..ny-1,
+// then inputs) from P periods: per line l in 1..L-1, (d C_l + d0 C0_l) / (d + d0) with one
+// weight for the whole matrix, C0_l = (d0 - 2) / d0 times the neighbours' mean with entry (p, q)
+// scaled by sqrt(k_p k_q) (k the channels' shape factors); d0 from the log variances of every
+// channel with enough noise (inputs first, then outputs); a line outlying in any channel keeps
+// its own matrix. With c = 2 and C_l = [[varY, covYU], [conj covYU, varU]] this is
+// moderated_noise. Throws std::invalid_argument for a C whose rows are not (L+1) c with c =
+// C.cols() >= 2, n_outputs outside 1..c-1, periods < 0, half_width < 1, or entries not finite.
+ModeratedCovariances moderated_covariances(const Eigen::MatrixXcd& C, int n_outputs, int periods, int half_width);
+
 // The special functions the moderation needs (x > 0; NaN otherwise).
 double digamma(double x);
 double trigamma(double x);

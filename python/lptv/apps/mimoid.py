@@ -73,9 +73,7 @@ def _check_options(args):
         if getattr(args, key, default) != default:
             opt = "--" + key.replace("_", "-")
             raise FileError(f"{opt} is for one input and one output; several channels take the files, "
-                            "--input, --output, the structure, --lines, --method, --max-iter, --tol and --out")
-    if getattr(args, "noise", None) == "moderated":     # the fit of several channels weighs by the sample's
-        raise FileError("--noise moderated is for one input and one output")
+                            "--input, --output, the structure, --lines, --method, --noise, --max-iter, --tol and --out")
     if getattr(args, "referred", "auto") not in ("auto",):
         raise FileError("--referred is for records of realisations of one input and one output")
     if args.covariance != "analytic":
@@ -140,7 +138,8 @@ def run(args) -> int:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             res = lptv.identify(experiments, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
-                                lines=lines, method=args.method, tol=args.tol, max_iter=args.max_iter)
+                                lines=lines, method=args.method, tol=args.tol, max_iter=args.max_iter,
+                                noise=getattr(args, "noise", None) or "auto")
     except NumericalError as e:
         return _fail(in_option_terms(_named(e, files), OPTION_NAMES), status=1)
     except ValueError as e:
@@ -216,6 +215,9 @@ def text_summary(res) -> str:
     std = _std(res)
     lines = [f"method {res.method.upper()}, converged {res.converged}, cost {res.cost:.4g}, "
              f"{res.lines.size} rows, {getattr(res, 'n_free_parameters', res.eta.size)} free parameters"]
+    if getattr(res, "noise", None):
+        lines.append(f"noise (co)variances: {res.noise}"
+                     + (f" ({res.noise_choice})" if res.noise_choice not in ("", "asked for") else " (asked for)"))
     width = max((len(n) for n in res.parameter_names), default=9)
     lines.append(f"{'parameter':<{width}}  {'estimate':>14}  {'std':>11}")
     for i, name in enumerate(res.parameter_names):
@@ -238,7 +240,8 @@ def json_summary(args, records, w0, ts, ka, kb, res, notes) -> dict:
         "inputs": list(first.input), "outputs": list(first.output),
         "n_inputs": res.model.n_inputs, "n_outputs": res.model.n_outputs,
         "w0": w0, "ts": ts, "na": res.model.na, "nb": res.model.nb, "ka": ka, "kb": kb,
-        "method": res.method, "n_rows": int(res.lines.size), "converged": bool(res.converged),
+        "method": res.method, "noise": getattr(res, "noise", "sample"), "noise_choice": getattr(res, "noise_choice", ""),
+        "n_rows": int(res.lines.size), "converged": bool(res.converged),
         "cost": float(res.cost),
         "parameters": [{"name": n, "value": float(res.eta[i]),
                         "std": None if std is None else float(std[i])}

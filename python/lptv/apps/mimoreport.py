@@ -38,6 +38,9 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
                   f"method {res.method.upper()}, converged {res.converged}, {res.lines.size} rows, "
                   f"{res.n_free_parameters} free parameters, normalised so that the mean of the leading "
                   "matrix A_na is the identity (METHOD.md section 19).")
+    route = getattr(res, "noise", "sample")
+    choice = getattr(res, "noise_choice", "")
+    rep.paragraph(f"Noise (co)variances: {route}" + (f" ({choice})" if choice else "") + ".")
     std = res.parameter_std
     rows = []
     for i, name in enumerate(res.parameter_names):
@@ -50,6 +53,9 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
     z = normalised_residues(res)
     ny = z.shape[1]
     P = min(res.periods) if len(res.periods) else 0
+    if getattr(res, "noise", "sample") == "moderated" and res.moderation:
+        # the periods the moderated (co)variances are worth (their median over the inner lines)
+        P = int(round(min(float(np.median(m.periods[1:-1])) for m in res.moderation)))
     fig, axes = plt.subplots(ny, 1, figsize=(7.5, 1.9 * ny + 0.6), sharex=True, squeeze=False)
     w = np.asarray(res.lines) * w0
     for p in range(ny):
@@ -66,7 +72,7 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
     rep.figure(fig, "residues.png",
                "Each output's normalised residue |e_p|^2 / C_e[p, p] on the rows of the fit (all experiments), "
                "in dB: about 0 dB (its mean) where the model is right; the dashed line is the 99 % point of "
-               f"F(2, 2(P-1)) for one row (P = {P}); the verdict judges every row of every output and all "
+               f"F(2, 2(P-1)) for one row (P = {P}{', what the moderated noise is worth' if route == 'moderated' else ''}); the verdict judges every row of every output and all "
                "outputs jointly with Holm's correction, not by this line.")
     plt.close(fig)
 

@@ -120,8 +120,10 @@ def _shape(z, ok, keep, W, var_log):
     log variances z over |x| <= SHAPE_WIDTH W (j != i, ok[j]); k_i = 1 / mean_j exp(beta x_j +
     c x_j^2 - q_j / 2), q_j the fitted shape's variance at x_j (var_log times the normal
     equations' inverse), which removes the fit's noise from the exponential's mean to first
-    order. Fewer than W points on either side of i within the fit's window (the first and last
-    lines: the trend at i would be extrapolated), or a singular fit: k = 1, v = 0."""
+    order. Near the first and last lines the window holds more lines on one side than on the
+    other (at the first and last inner lines, on one side only) and the trend at i is
+    extrapolated by one line there; its larger variance enters v. Fewer than 2 W points in the
+    window, or a singular fit: k = 1, v = 0."""
     m = z.size
     S = SHAPE_WIDTH * W
     C = np.zeros((5, m))
@@ -147,7 +149,7 @@ def _shape(z, ok, keep, W, var_log):
         right[:m - x] += ok[x:]
     k, v = np.ones(m), np.zeros(m)
     for i in range(m):
-        if left[i] < W or right[i] < W:
+        if left[i] + right[i] < 2 * W:
             continue
         A = np.array([[C[0, i], C[1, i], C[2, i]], [C[1, i], C[2, i], C[3, i]], [C[2, i], C[3, i], C[4, i]]])
         try:
@@ -280,3 +282,123 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     return ModeratedNoise(data=moderated, dof=dof, prior_dof=float(d0), outliers=inner[out],
                           half_width=W, own_weight=own_weight, neighbour=neighbour, source_varU=vu,
                           source_varY=vy)
+
+
+@dataclass(frozen=True)
+class ModeratedCovariances:
+    """What :func:`moderated_covariances` returns (the arrays of several channels)."""
+
+    C: np.ndarray
+    """The moderated covariance matrices of the means, shape (L+1, c, c)."""
+    dof: np.ndarray
+    prior_dof: float
+    outliers: np.ndarray
+    half_width: int
+    own_weight: np.ndarray
+    neighbour: np.ndarray
+
+
+def moderated_covariances(C, periods: int, n_outputs: int, half_width: int = 10) -> ModeratedCovariances:
+    """METHOD.md section 19, "Moderated noise for several channels", in NumPy and SciPy: the
+    covariance matrices C (L+1, c, c) of c = ny + nu channels (outputs first) from P periods,
+    each line's combined with its neighbours' mean by section 7's rule with one weight
+    d / (d + d0) for the whole matrix (the conjugate inverse-Wishart prior); d0 from the log
+    variances of every channel (inputs first, then outputs, as the single-channel pair (u, y)),
+    a line outlying in any channel keeps its own matrix, and entry (p, q) of the neighbours'
+    mean is scaled by sqrt(k_p k_q) (k the channels' shape factors). With c = 2,
+    ``C = [[varY, covYU], [conj(covYU), varU]]`` this is :func:`moderated_noise`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lptv.reference.moderation import moderated_covariances
+    >>> rng = np.random.default_rng(0)
+    >>> z = rng.standard_normal((4, 200, 3)) + 1j * rng.standard_normal((4, 200, 3))
+    >>> dz = z - z.mean(0)
+    >>> C = np.einsum("plc,pld->lcd", dz, dz.conj()) / 12
+    >>> mo = moderated_covariances(C, 4, 2)
+    >>> mo.C.shape, bool(mo.prior_dof > 6)
+    ((200, 3, 3), True)
+    """
+    from scipy import special, stats
+
+    C = np.asarray(C, complex)
+    W = as_int(half_width, "half_width", minimum=1, maximum=10**6)
+    P = int(periods)
+    L = C.shape[0] - 1
+    c = C.shape[1]
+    ny = int(n_outputs)
+    order = list(range(ny, c)) + list(range(ny))          # inputs first, then outputs
+    var = np.real(np.diagonal(C, axis1=1, axis2=2)).copy()
+    own = 2.0 * (P - 1) if P >= 2 else np.inf
+    dof = np.full(L + 1, own)
+    if P >= 2:
+        dof[0] = dof[L] = P - 1.0
+
+    def unchanged():
+        return ModeratedCovariances(C=C.copy(), dof=dof, prior_dof=0.0, outliers=np.zeros(0, int), half_width=W,
+                                    own_weight=np.ones(L + 1), neighbour=np.zeros(L + 1, bool))
+
+    if P < 2 or L < 3 * W + 2:
+        return unchanged()
+    d = own
+    inner = np.arange(1, L)
+    mean_log = special.digamma(d / 2) - np.log(d / 2)
+    var_log = special.polygamma(1, d / 2)
+    channels = [var[inner, q] for q in order if np.count_nonzero(var[inner, q] > 0) >= 3 * W]
+    if not channels:
+        return unchanged()
+    out = np.zeros(inner.size, bool)
+    for _ in range(2):
+        for v in channels:
+            ok = (v > 0) & ~out
+            s, n = _window_sums(v, ok, W)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                m = s / n
+            q = stats.f.isf(OUTLIER_RATE, d, np.maximum(n, 1) * d)
+            out |= (n > 0) & (v > q * m)
+    r2 = []
+    for v in channels:
+        ok = (v > 0) & ~out
+        z = np.where(ok, np.log(np.where(ok, v, 1.0)) - mean_log, 0.0)
+        s, n = _window_sums(z, ok, W)
+        use = ok & (n >= W)
+        r = z[use] - s[use] / n[use]
+        r2.append(r ** 2 / (1.0 + 1.0 / n[use]))
+    r2 = np.concatenate(r2)
+    if r2.size < 3 * W:
+        return unchanged()
+    excess = float(np.mean(r2)) - var_log
+    d0 = MAX_PRIOR_DOF if excess <= 0 else min(2.0 * _trigamma_inverse(excess), MAX_PRIOR_DOF)
+    keep = ~out
+    n = _window_sums(np.ones(inner.size), keep, W)[1]
+    use = keep & (n > 0)
+    scale = max(d0 - 2.0, 0.0) / d0
+    w = d / (d + d0)
+    k = np.ones((inner.size, c))
+    vk = np.zeros(inner.size)
+    for q in range(c):
+        vi = var[inner, q]
+        okv = (vi > 0) & keep
+        if np.count_nonzero(okv) >= 3 * W:
+            z = np.log(np.where(okv, vi, 1.0)) - mean_log
+            k[:, q], vq = _shape(z, okv, keep, W, var_log)
+            vk = np.maximum(vk, vq)
+    Cm = C.copy()
+    sr = np.zeros((inner.size, c, c))
+    si = np.zeros((inner.size, c, c))
+    for p in range(c):
+        for q in range(c):
+            sr[:, p, q] = _window_sums(C[inner, p, q].real, keep, W)[0]
+            si[:, p, q] = _window_sums(C[inner, p, q].imag, keep, W)[0]
+    kk = np.sqrt(k[:, :, None] * k[:, None, :])
+    mean = kk * (sr + 1j * si) / np.maximum(n, 1)[:, None, None]
+    Cm[inner[use]] = w * C[inner[use]] + (1 - w) * scale * mean[use]
+    nn = n[use].astype(float)
+    dof[inner[use]] = (d + d0) ** 2 / (d + d0 + d0 ** 2 * (1.0 / (nn * d) + vk[use] / 2.0))
+    own_weight = np.ones(L + 1)
+    own_weight[inner[use]] = w
+    neighbour = np.zeros(L + 1, bool)
+    neighbour[inner[keep]] = True
+    return ModeratedCovariances(C=Cm, dof=dof, prior_dof=float(d0), outliers=inner[out], half_width=W,
+                                own_weight=own_weight, neighbour=neighbour)
