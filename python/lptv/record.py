@@ -21,6 +21,7 @@ import numpy as np
 from . import _core
 from ._validate import as_counts, as_int, as_positive_float, as_real_1d, as_seed
 from .model import Model
+from .record_score import harmonic_score_tests
 from .record_verdict import RecordVerdict, record_verdict
 
 
@@ -102,7 +103,8 @@ class RecordResult:
     def model_errors(self) -> Tuple[str, ...]:
         """The signs of a model error, each as a sentence (empty when none): the residual
         explained by the input on the same line (an order too few) or shifted by k w0 (a
-        missing harmonic k), at the verdict's size of 1 %; a fit that did not converge."""
+        missing harmonic k), or by a coefficient's next harmonic (its score test), at the
+        verdict's size of 1 % (Holm over the tests); a fit that did not converge."""
         errs = () if self.record_verdict is None else self.record_verdict.model_errors
         if not self.converged:
             errs = errs + (f"the fit did not converge in {self.iterations} iterations: its estimate is not "
@@ -119,9 +121,11 @@ class RecordResult:
         """One sentence: is the model consistent with the record, and if not, why."""
         if self.model_ok:
             v = self.record_verdict
+            more = (f", and no coefficient's next harmonic explains it ({len(v.score_tests)} score tests, "
+                    f"smallest p = {min(t[4] for t in v.score_tests):.2g})") if v.score_tests else ""
             return ("the model is consistent with the record: its residual is not explained by the input or "
-                    f"its shifts by up to {max(v.shifts)} w0 (F = {v.statistic:.3g}, p = {v.p_value:.2g}, "
-                    f"size {100 * v.alpha:g} %)")
+                    f"its shifts by up to {max(v.shifts)} w0 (F = {v.statistic:.3g}, p = {v.p_value:.2g})" + more
+                    + f"; Holm's size {100 * v.alpha:g} %")
         return "MODEL ERRORS: " + "; ".join(self.model_errors)
 
 
@@ -343,7 +347,10 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
             b[order, Kb + k] = v
     cov_eta = np.asarray(fit.covariance)
     Y_fit = np.asarray(fit.Y_fit)
-    verdict = record_verdict(U, (Y[lines] - Y_fit) / np.sqrt(var), lines, L, kmax)
+    scores = harmonic_score_tests(na, nb, ka_l, kb_l, w0, 0.0 if continuous else float(ts), U, Y[lines] - Y_fit, L,
+                                  lines, np.asarray(fit.eta), np.asarray(fit.transient), var, float(ts), t_degree,
+                                  continuous)
+    verdict = record_verdict(U, (Y[lines] - Y_fit) / np.sqrt(var), lines, L, kmax, scores=scores)
     said = []
     if not fit.converged:
         said.append(f"identify_record: the fit did not converge in {int(fit.iterations)} iterations "

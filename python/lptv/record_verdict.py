@@ -41,6 +41,9 @@ class RecordVerdict:
     window: int
     alpha: float
     model_errors: Tuple[str, ...]
+    score_tests: Tuple = ()
+    """(coefficient and harmonic, F, d1, d2, p-value) of each score test for one more harmonic of
+    one coefficient (METHOD.md section 17); combined with the windowed test by Holm at alpha."""
 
     @property
     def model_ok(self) -> bool:
@@ -53,9 +56,11 @@ def _window(n_regressors: int) -> int:
     return max(15, 4 * n_regressors)
 
 
-def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA) -> RecordVerdict:
+def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA, scores=()) -> RecordVerdict:
     """The verdict of a one-record fit from the record's full DFT ``U`` (N lines), the
-    normalised residual on ``lines`` and the model's largest harmonic count ``kmax``."""
+    normalised residual on ``lines`` and the model's largest harmonic count ``kmax``;
+    ``scores``: the score tests of :func:`lptv.record_score.harmonic_score_tests`, combined with
+    the windowed test's pooled p-value by Holm's method at ``alpha``."""
     from ._dist import f_sf
 
     N = U.size
@@ -99,16 +104,31 @@ def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA) -> RecordV
                 r2 = ew
             drop[col] += float(np.vdot(r2, r2).real) - float(np.vdot(rest, rest).real)
             seen[col] += 1
+    scores = tuple(scores)
     if d_expl == 0 or d_rest == 0 or s_rest <= 0:
         return RecordVerdict(np.nan, (d_expl, d_rest), np.nan, shifts, tuple([np.nan] * q), W, alpha,
                              ("the verdict needs at least one window of "
-                              f"{W} lines where the input is nonzero",))
+                              f"{W} lines where the input is nonzero",), scores)
     F = (s_expl / d_expl) / (s_rest / d_rest)
     p = float(f_sf(F, d_expl, d_rest))
     per = [float(f_sf((drop[j] / (2 * seen[j])) / (s_rest / d_rest), 2 * seen[j], d_rest)) if seen[j] else np.nan
            for j in range(q)]
+    # Holm over the windowed test and the score tests: the smallest p against alpha / m, ...
+    ps = [p] + [t[4] for t in scores]
+    m = len(ps)
+    passed = set()
+    for rank_i, i in enumerate(np.argsort(ps)):
+        if not ps[i] < alpha / (m - rank_i):
+            break
+        passed.add(int(i))
     errors = []
-    if p < alpha:
+    for i in sorted(passed - {0}):
+        name, Fc, d1, d2, pc = scores[i - 1]
+        coef, k = name.split(" harmonic ")
+        errors.append(f"the residual follows harmonic {k} of {coef} (a score test: F = {Fc:.3g} "
+                      f"on {d1} and {d2} degrees of freedom, p = {pc:.2g}; Holm at {alpha:g} over {m} tests): "
+                      "that harmonic is missing in the coefficient")
+    if 0 in passed:
         errors.append(f"the residual is explained by the input (F = {F:.3g} on {d_expl} and {d_rest} degrees of "
                       f"freedom, p = {p:.2g} < {alpha:g}): the structure misses what the data show")
         # Holm over the shifts: name those that stand out
@@ -123,4 +143,4 @@ def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA) -> RecordV
             else:
                 errors.append(f"on the input shifted by {k:+d} w0 (p = {per[j]:.2g}): a harmonic {abs(k)} missing "
                               "in a coefficient")
-    return RecordVerdict(float(F), (d_expl, d_rest), p, shifts, tuple(per), W, alpha, tuple(errors))
+    return RecordVerdict(float(F), (d_expl, d_rest), p, shifts, tuple(per), W, alpha, tuple(errors), scores)
