@@ -102,7 +102,10 @@ class ResidueTests:
             why = ("" if t.statistic > 0 else
                    ": an over-fitted structure, or noise variances inflated by a disturbance that is not "
                    "periodic in the record (a sinusoid off the period's grid, such as mains hum: "
-                   "lptv.disturbances(u, y) finds it, identify(..., disturbances='remove') removes it)")
+                   "lptv.disturbances(u, y) finds it, identify(..., disturbances='remove') removes it), "
+                   "or by leakage: a noise spectrum that falls by 40 dB or more within the fitted lines, "
+                   "with no floor, leaks from its high lines into the periods' variances of its low ones "
+                   "(a longer period, or leaving those lines out of the fit, helps)")
             out.append(f"the normalised residues on the {t.rows.size} {t.name} are {side} "
                        f"(z = {t.statistic:.2f}, p = {t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} "
                        f"< {self.alpha:g}){why}")

@@ -279,3 +279,38 @@ def test_noise_option_gives_the_api_route(noise, experiments, files, tmp_path, c
     names = [p["name"] for p in summary["parameters"]]
     values = {p["name"]: p["value"] for p in summary["parameters"]}
     assert [values[n] for n in names if n.startswith("a2[") and n.endswith(".re0")] == [1.0, 0.0, 0.0, 1.0]
+
+
+@needs_fit
+def test_inspect_several_channels_suggests_the_command_that_fits_them(files, tmp_path, capsys):
+    """lptv inspect with comma lists inspects every input (with the first output) and every further
+    output (with the first input), finds the period common to all (N samples: the solve_ivp
+    records repeat every period) and suggests lptv identify for all channels; that command, with
+    the orders filled in and the second experiment's file added, fits and accepts the model."""
+    import shlex
+
+    rc = cli.main(["inspect", str(files[0]), "--input", "f1,f2", "--output", "x1,x2", "--out", str(tmp_path / "i")])
+    out, err = capsys.readouterr()
+    assert rc == 0, out + err
+    assert "== pair 0: input 'F1 [N]', output 'x1 [m]' ==" in out
+    assert "== pair 2: input 'F1 [N]', output 'x2 [m]' ==" in out
+    assert f"all channels: every channel repeats every {N} samples" in out
+    summary = json.loads((tmp_path / "i" / "summary.json").read_text())
+    assert summary["period_samples"] == N and len(summary["pairs"]) == 3
+    assert summary["inputs"] == ["F1 [N]", "f2 [N]"] and summary["outputs"] == ["x1 [m]", "x2 [m]"]
+    assert (tmp_path / "i" / "report.html").exists() and (tmp_path / "i" / "pair1" / "report.html").exists()
+    argv = shlex.split(summary["command"])
+    assert argv[:3] == ["lptv", "identify", str(files[0])]
+    fill = {"NA": "2", "NB": "0", "KA": "1,0,0", "KB": "0"}
+    argv = [argv[2], str(files[1])] + [fill.get(a, a) for a in argv[3:]] + ["--out", str(tmp_path / "o")]
+    rc, out, err = identify_cli(capsys, *argv)
+    assert rc == 0, out + err
+    assert "verdict: consistent" in out
+    period = float(argv[argv.index("--period") + 1])
+    assert period == pytest.approx(T0, rel=1e-9)
+
+
+def test_inspect_several_channels_names_a_channel_it_cannot_find(files, capsys):
+    rc = cli.main(["inspect", str(files[0]), "--input", "f1,nope", "--output", "x1,x2"])
+    out, err = capsys.readouterr()
+    assert rc == 2 and "nope" in err and len(err.strip().splitlines()) == 1

@@ -14,6 +14,7 @@ that does not repeat, an output that does not repeat with the input.
 Example::
 
     lptv inspect rig.csv --input force --output displacement
+    lptv inspect exp0.csv --input f1,f2 --output x1,x2     (several channels: lptv.apps.inspectmimo)
 """
 from __future__ import annotations
 
@@ -49,8 +50,9 @@ def add_parser(sub):
                               "  lptv inspect record.npz --fs 100\n"
                               "  lptv inspect rig.csv --input force --output displacement --reach 3")
     p.add_argument("file", metavar="FILE", help="measurements: .csv, .npz or .mat (as for lptv identify)")
-    p.add_argument("--input", metavar="NAME", help="the input channel (default u; matched up to case and a unit)")
-    p.add_argument("--output", metavar="NAME", help="the output channel (default y)")
+    p.add_argument("--input", metavar="NAME", help="the input channel (default u; matched up to case and a unit); "
+                   "several as a comma list (each inspected with the first output)")
+    p.add_argument("--output", metavar="NAME", help="the output channel (default y); several as a comma list")
     p.add_argument("--time", metavar="NAME", help="a time column or variable (default: one named t, time, time [s] ...)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--fs", type=float, help="sampling frequency in Hz (default: the file's)")
@@ -73,6 +75,9 @@ def run(args) -> int:
         output_folder(args.out)
     except OSError as e:
         return _fail(e.filename or args.out, e.strerror or e)
+    if any(v is not None and "," in v for v in (args.input, args.output)):
+        from lptv.apps import inspectmimo
+        return inspectmimo.run(args, summary, report, _fail)
     try:
         insp = inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt, reach=args.reach)
     except ValueError as e:
