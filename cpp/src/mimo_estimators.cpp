@@ -255,7 +255,9 @@ VectorXd normalise(const MatrixXd& V, const Params& p) {
   Eigen::FullPivLU<MatrixXd> lu(Nm);
   if (!lu.isInvertible())
     throw NumericalError("the normalisation A_na,0 = I cannot be applied: the leading matrix's mean is singular "
-                         "in the subspace of the smallest singular values");
+                         "in the subspace of the smallest singular values (the structure does not describe the "
+                         "data: an order too low or too high for some output, or harmonic counts the data "
+                         "cannot determine)");
   return V * lu.solve(c);
 }
 
