@@ -53,6 +53,10 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 export CCACHE_DIR := $(CURDIR)/$(BUILDROOT)/ccache
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := true
+# one compiler name for both builds (ccache tells compilers apart by the name they are called by:
+# CMake's default c++ and the Python build's g++ missed each other)
+CXX ?= g++
+export CXX
 CCACHE_LAUNCH = $(if $(shell command -v ccache),ccache,)
 
 .PHONY: test demo bench bench-smoke deps deps-build deps-bench venv venv-demo cpp cpp-test consumer python \
