@@ -56,7 +56,6 @@ SMOKE = {
     "bench_ml_lti.py": ["--rounds", "1", "--inner", "1", "--fditools", ""],
     "bench_moderation_core.py": ["1"],
     "bench_noise_route.py": ["--runs", "2", "--periods", "4", "--workers", "1"],
-    "bench_verdict_tests.py": ["--seeds", "0", "3", "--periods", "4"],
     "bench_multi_experiment.py": ["3"],
     "bench_record.py": ["--runs", "3", "--periods", "4"],
     "bench_record_core.py": ["1", "4"],
@@ -71,6 +70,7 @@ SMOKE = {
     "bench_uncertainty.py": ["3", "4"],
     "bench_verdict.py": ["--runs", "2", "--periods", "4", "--systems", "paper", "--workers", "1"],
     "bench_verdict_tests.py": ["--runs", "3", "--periods", "4", "--workers", "1"],
+    "bench_verdict_cells.py": ["--seeds", "0", "3", "--periods", "4"],
     "bench_wgtls.py": ["1", "1"],                        # seed 1, one round
     "ct_record_aliasing.py": ["--os", "4", "--seeds", "1"],
     "periodic_records.py": [],                          # the records against their stated truth

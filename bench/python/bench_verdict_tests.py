@@ -1,65 +1,101 @@
-"""The verdict's tests one by one on the records of bench/python/periodic_records.py: how often
-each test's p-value falls below 1 % and 0.1 % on a right structure, and which tests reject.
+"""The verdict's tests one by one without a model error, on the sample and on the moderated noise
+variances, paired (the same fits judged both ways).
 
-    python bench/python/bench_verdict_tests.py [--system lti4] [--periods 16] [--seeds 0 2000]
-        [--method wgtls]
+For each system and P, R realisations of the true structure fitted by WGTLS (the default; or
+SML with ``--method sml``); the
+verdict (METHOD.md section 7) is formed once on each line's own sample (co)variances
+(``lptv.verdict.MODERATE = False``) and once on the moderated ones (the default). Printed: the
+family's size (any Holm-adjusted p-value below 1 %) with its binomial standard error, and per
+test the mean and standard deviation of its statistic (residue groups: N(0, 1); score tests:
+F(2, nu), mean and standard deviation about 1) and how often its own p-value falls below 5 %,
+1 %, 0.1 %, then pooled over the tests.
 
-Each record is fitted by ``lptv.identify`` (the default noise route) with the system's right
-structure; the verdict's tests are read from ``res.residue_tests``: the residue sum over the rows
-with signal, the offset groups, and the score tests for one more harmonic per coefficient.
-Without a model error every p-value is uniform: 1 % below 0.01, 0.1 % below 0.001.
+    python bench/python/bench_verdict_tests.py --runs 400 --periods 4 --systems third_order
+    python bench/python/bench_verdict_tests.py --runs 300 --periods 8 16 32 --systems discrete third_order
+    python bench/python/bench_verdict_tests.py --runs 400 --periods 4 --systems discrete --noise moderated
+    python bench/python/bench_verdict_tests.py --runs 500 --periods 4 8 16 32 --systems paper third_order discrete --method sml
+
+``--noise moderated`` fits with ``lptv.identify(..., noise='moderated')``; the verdict then reads the
+fit's own moderated variances (judged once).
 """
 from __future__ import annotations
 
 import argparse
-import collections
+import os
 import sys
-import time
 import warnings
-from pathlib import Path
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-import lptv
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from periodic_records import SYSTEMS, record  # noqa: E402
+import lptv  # noqa: E402
+import lptv.verdict  # noqa: E402
+from lptv.examples import SYSTEMS, system_measurements  # noqa: E402
+
+
+def one(args):
+    system, P, seed, stream, noise, method = args
+    rng = np.random.default_rng([seed, P, stream + SYSTEMS.index(system)])
+    d = system_measurements(system, seed=rng, periods=P)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], ts=d["ts"], lines=d["lines"],
+                            noise=noise, method=method)
+    out = []
+    for moderate in ((False, True) if noise == "sample" else (True,)):
+        lptv.verdict.MODERATE = moderate
+        t = lptv.verdict.residue_tests(res, res.structure)
+        out.append((system, P, moderate, [(x.name, x.statistic, x.p_value, x.p_holm) for x in t.tests]))
+    return out
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser()
-    ap.add_argument("--system", default="lti4", choices=SYSTEMS)
-    ap.add_argument("--periods", type=int, default=16)
-    ap.add_argument("--seeds", type=int, nargs=2, default=[0, 2000])
-    ap.add_argument("--method", default="wgtls", choices=("wgtls", "sml"))
+    ap.add_argument("--runs", type=int, default=400)
+    ap.add_argument("--periods", type=int, nargs="+", default=[4])
+    ap.add_argument("--systems", nargs="+", default=["third_order"])
+    ap.add_argument("--stream", type=int, default=11, help="seed stream (other than bench_verdict.py's)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--noise", default="sample", choices=("sample", "moderated"),
+                    help="the noise the fits weigh by; 'moderated': judged once, on the fit's own moderation")
+    ap.add_argument("--method", default="wgtls", choices=("wgtls", "sml"), help="the estimator fitted")
     args = ap.parse_args(argv)
-    t0 = time.time()
-    stat, pv = collections.defaultdict(list), collections.defaultdict(list)
-    who, rejected = collections.Counter(), []
-    for seed in range(*args.seeds):
-        d = record(args.system, args.periods, [seed, args.periods, SYSTEMS.index(args.system), 3], noise="smooth")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            r = lptv.identify(d["u"], d["y"], **d["structure"], w0=d["w0"], ts=d["ts"], lines=d["rows"],
-                              method=args.method)
-        rejected.append(not r.model_ok)
-        for t in r.residue_tests.tests:
-            key = t.name if t.kind == "score" else ("the rows with signal" if t.name == "rows with signal"
-                                                     else "offset groups")
-            stat[key].append(t.statistic)
-            pv[key].append(t.p_value)
-            if t.rejects:
-                who[key] += 1
-    n = len(rejected)
-    p = float(np.mean(rejected))
-    print(f"bench_verdict_tests.py --system {args.system} --periods {args.periods} --seeds {args.seeds[0]} "
-          f"{args.seeds[1]} --method {args.method}: {n} records in {time.time() - t0:.0f} s")
-    print(f"rejected: {100 * p:.2f} +- {100 * np.sqrt(max(p, 1 / n) * (1 - p) / n):.2f} %")
-    print(f"{'test':<36} {'count':>6} {'mean statistic':>15} {'p < 0.01':>9} {'p < 0.001':>10} {'rejects':>8}")
-    for k in stat:
-        s, q = np.array(stat[k]), np.array(pv[k])
-        print(f"{k:<36} {s.size:>6} {s.mean():>15.3f} {100 * np.mean(q < 0.01):>8.2f}% {100 * np.mean(q < 0.001):>9.3f}% "
-              f"{who[k]:>8}")
+    tasks = [(s, P, i, args.stream, args.noise, args.method) for s in args.systems for P in args.periods for i in range(args.runs)]
+    with ProcessPoolExecutor(args.workers) as ex:
+        rows = [o for chunk in ex.map(one, tasks, chunksize=8) for o in chunk]
+    print(f"# {len(tasks)} realisations, {args.method.upper()} weighed by {args.noise} noise, seed stream {args.stream}")
+    for moderate in ((False, True) if args.noise == "sample" else (True,)):
+        sel = [r for r in rows if r[2] == moderate]
+        rej = np.array([min(x[3] for x in r[3]) <= lptv.verdict.ALPHA for r in sel], float)
+        p = rej.mean()
+        print(f"\n{'moderated' if moderate else 'sample'} variances: size {100 * p:.2f} +- "
+              f"{100 * np.sqrt(p * (1 - p) / rej.size):.2f} % ({int(rej.sum())} of {rej.size})")
+        for s in args.systems:
+            print("   " + "  ".join(f"{s} P={P}: {int(sum(min(x[3] for x in r[3]) <= lptv.verdict.ALPHA for r in sel if r[0] == s and r[1] == P))}"
+                                  f"/{sum(1 for r in sel if r[0] == s and r[1] == P)}" for P in args.periods))
+        names = sorted({x[0] for r in sel for x in r[3]})
+        for n in names:
+            st = np.array([x[1] for r in sel for x in r[3] if x[0] == n])
+            pv = np.array([x[2] for r in sel for x in r[3] if x[0] == n])
+            print(f"   {n[:46]:46s} mean {st.mean():6.2f} sd {st.std():5.2f}  p<0.05 {np.mean(pv < 0.05):.3f} "
+                  f"p<0.01 {np.mean(pv < 0.01):.3f} p<0.001 {np.mean(pv < 0.001):.4f}")
+        why = {}
+        for r in sel:
+            for x in r[3]:
+                if x[3] <= lptv.verdict.ALPHA:
+                    key = x[0] + (" (too small)" if x[1] < 0 and "harmonic" not in x[0] else "")
+                    why.setdefault(key, []).append(f"{r[0][:5]}{r[1]}")
+        for n, where in sorted(why.items()):
+            print(f"   rejects: {n[:58]:58s} {len(where):3d}x  {' '.join(where)}")
+        kk = np.array([len(r[3]) for r in sel])
+        bonf = np.array([min(x[2] for x in r[3]) * k for r, k in zip(sel, kk)])
+        print(f"   families whose smallest p-value is below 1 % / k (Bonferroni; k = {kk.min()}-{kk.max()} tests): "
+              f"{100 * np.mean(bonf <= lptv.verdict.ALPHA):.2f} %")
+        allp = np.array([x[2] for r in sel for x in r[3]])
+        print(f"   pooled over the tests (n = {allp.size}): p<0.05 {np.mean(allp < 0.05):.4f} "
+              f"p<0.01 {np.mean(allp < 0.01):.4f} p<0.001 {np.mean(allp < 0.001):.4f}")
     return 0
 
 
