@@ -35,7 +35,7 @@ def _noise_route(datas, noise):
                               "or not from periods)"), None
         return "moderated", "asked for", mos
     mos, why = [], []
-    for d in datas:
+    for e, d in enumerate(datas):
         if d.periods < AUTO_MIN_PERIODS:
             return "sample", (f"the sample (co)variances: {d.periods} periods (the moderated route needs "
                               f"{AUTO_MIN_PERIODS})"), None
@@ -44,7 +44,7 @@ def _noise_route(datas, noise):
         if not ok:
             return "sample", "the sample (co)variances: " + reason, None
         mos.append(mo)
-        why.append(reason)
+        why.append(f"experiment {e}: {reason}" if len(datas) > 1 else reason)
     return "moderated", "moderated: " + "; ".join(why), mos
 
 

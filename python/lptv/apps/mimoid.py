@@ -216,8 +216,11 @@ def text_summary(res) -> str:
     lines = [f"method {res.method.upper()}, converged {res.converged}, cost {res.cost:.4g}, "
              f"{res.lines.size} rows, {getattr(res, 'n_free_parameters', res.eta.size)} free parameters"]
     if getattr(res, "noise", None):
-        lines.append(f"noise (co)variances: {res.noise}"
-                     + (f" ({res.noise_choice})" if res.noise_choice not in ("", "asked for") else " (asked for)"))
+        choice = res.noise_choice
+        if choice in ("", "asked for"):
+            lines.append(f"noise (co)variances: {res.noise} (asked for)")
+        else:     # noise='auto': the route and why, e.g. 'moderated: the noise spectrum is smooth ...'
+            lines.append(f"noise (co)variances (noise='auto'): {choice}")
     width = max((len(n) for n in res.parameter_names), default=9)
     lines.append(f"{'parameter':<{width}}  {'estimate':>14}  {'std':>11}")
     for i, name in enumerate(res.parameter_names):

@@ -40,7 +40,8 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
                   "matrix A_na is the identity (METHOD.md section 19).")
     route = getattr(res, "noise", "sample")
     choice = getattr(res, "noise_choice", "")
-    rep.paragraph(f"Noise (co)variances: {route}" + (f" ({choice})" if choice else "") + ".")
+    rep.paragraph(f"Noise (co)variances: {route} (asked for)." if choice in ("", "asked for") else
+                  f"Noise (co)variances (noise='auto'): {choice}.")
     std = res.parameter_std
     rows = []
     for i, name in enumerate(res.parameter_names):
