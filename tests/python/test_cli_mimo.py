@@ -219,6 +219,10 @@ def test_channels_and_options_it_cannot_use_are_one_line_errors(files, tmp_path,
     assert rc == 2 and "an empty channel name" in err
     rc, out, err = identify_cli(capsys, files[0], "--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb",
                                 "0", "--period", T0, "--fs", 3.3)
+    # the record's own time column names the cause (as for one channel), not the split's count
+    assert rc == 2 and "--fs 3.3 contradicts the file's column 'time'" in err
+    rc, out, err = identify_cli(capsys, files[0], "--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb",
+                                "0", "--period", T0, "--fs", 3.3, "--no-period-check")
     assert rc == 2 and "not a whole number" in err
 
 
@@ -314,3 +318,18 @@ def test_inspect_several_channels_names_a_channel_it_cannot_find(files, capsys):
     rc = cli.main(["inspect", str(files[0]), "--input", "f1,nope", "--output", "x1,x2"])
     out, err = capsys.readouterr()
     assert rc == 2 and "nope" in err and len(err.strip().splitlines()) == 1
+
+
+@needs_fit
+def test_a_wrong_period_is_named_by_the_record_not_blamed_on_the_fit(files, capsys):
+    """The record's own diagnosis (the first input and output) names a period the record does not
+    repeat at, and a period of several of its periods that leaves too few for several outputs;
+    --no-period-check fits the record as cut."""
+    base = ["--input", "f1,f2", "--output", "x1,x2", "--na", "2", "--nb", "0", "--ka", "1,0,0", "--no-report"]
+    rc, out, err = identify_cli(capsys, *files, *base, "--period", 0.8 * T0)
+    assert rc == 2 and "the input repeats every 6.28 s (64 samples)" in err and f"use --period {T0:.12g}" in err, err
+    rc, out, err = identify_cli(capsys, *files, *base, "--period", 4 * T0)
+    assert rc == 2 and "holds 4 of them and leaves 2 periods, and 2 outputs need more than 2" in err, err
+    assert f"use --period {T0:.12g}" in err
+    rc, out, err = identify_cli(capsys, *files, *base, "--period", 4 * T0, "--no-period-check")
+    assert rc == 2 and "several outputs need P > ny periods" in err

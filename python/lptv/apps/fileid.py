@@ -204,41 +204,6 @@ def _fail(name, problem, status=2) -> int:
     return status
 
 
-def _read_failure_cause(diag, args, error):
-    """A reader's error with the record's own diagnosis where that names the cause: an fs or a
-    period (in s) that contradicts the record replaces it; for a record split by --periods or
-    stored as periods x samples arrays, where the reader's count is itself the news, the cause
-    is added to it."""
-    text = str(error)
-    if diag is None or args.no_period_check:
-        return text
-    fs = args.fs if args.fs is not None else (1 / args.dt if args.dt else None)
-    if fs is None and args.periods is None:
-        fs = diag.file_fs
-    period = inspectrec.period_option(args)
-    n, by_count = None, False
-    if fs and period:
-        n = fs * period[1]
-    elif args.periods:
-        n, by_count = diag.samples / args.periods, True
-    cause = inspectrec.setup_problem(diag, args, n)
-    split = re.search(r"whole|drop \d+ samples|samples per period|less than one period|period is needed|"
-                      r"--periods is required|needs the period|: give ", text)
-    if cause is None:
-        if n is None and diag.repeats and split:
-            hint = f"--period {diag.period:.12g}" if diag.period is not None else f"--periods {diag.periods}"
-            return f"{text}; the input repeats every {diag.seconds(diag.period_samples)}: {hint}"
-        return text
-    if cause.startswith(("--fs", "--dt")):
-        return cause
-    if not diag.repeats:
-        # a reader's count on arrays stored the other way round, or on a record too short, stands
-        return cause if split and diag.stored_period is None else text
-    if by_count or diag.stored_period is not None:
-        return f"{text}; {cause}"
-    return cause
-
-
 # ------------------------------------------------------------------------------ running
 
 def run(args) -> int:
@@ -302,7 +267,7 @@ def run(args) -> int:
         try:
             meas = read_record(src, args, realisations=True)
         except FileError as e:
-            cause = _read_failure_cause(diag, args, e)
+            cause = inspectrec.read_failure_cause(diag, args, e)
             raise FileError(cause if cause == str(e) else f"{cause} (--no-period-check skips the check)") from None
         if meas.realisations:
             diag = None

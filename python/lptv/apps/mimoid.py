@@ -18,6 +18,7 @@ Example::
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import re
 import sys
@@ -30,6 +31,7 @@ import lptv
 from lptv import NumericalError
 from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fundamental, in_option_terms, integer,
                                output_folder, parse_counts, parse_lines, positive, read_options)
+from lptv.apps import inspectrec
 from lptv.apps.report import write_fit
 from lptv.measurements import FileError, read_measurements
 
@@ -92,11 +94,30 @@ def read_experiments(args):
     outputs = channel_list(args.output, "--output") or ["y"]
     records, w0s = [], []
     ts = args.ts
+    check = not getattr(args, "no_period_check", False)
+    first = copy.copy(args)             # the record's own diagnosis reads the first input and output
+    first.input, first.output = inputs[0], outputs[0]
     for src in args.files:
+        diag = inspectrec.diagnose(src, first) if check else None
         try:
             kw = read_options(args)
             kw.update(u=inputs, y=outputs)
-            meas = read_measurements(src, **kw)
+            try:
+                meas = read_measurements(src, **kw)
+            except FileError as e:      # a period or fs that contradicts the record: its cause instead
+                cause = inspectrec.read_failure_cause(diag, first, e)
+                raise FileError(cause if cause == str(e) else f"{cause} (--no-period-check skips the check)") from None
+            N = meas.u.shape[1]
+            checked = inspectrec.setup_problem(diag, first, N) if diag is not None else None
+            if checked:
+                raise FileError(f"{checked} (--no-period-check fits the record as cut anyway)")
+            P, ny = meas.u.shape[0], meas.y.shape[2]
+            if diag is not None and diag.repeats and ny > 1 and P <= ny and N > diag.period_samples \
+                    and N % diag.period_samples == 0:
+                fix = f"--period {diag.period:.12g}" if diag.period is not None else f"--periods {diag.periods}"
+                raise FileError(f"the record repeats every {diag.seconds(diag.period_samples)}; the period given holds "
+                                f"{N // diag.period_samples} of them and leaves {P} periods, and {ny} outputs need more "
+                                f"than {ny}: use {fix}")
             if args.discrete:
                 if args.ts is not None:
                     raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
