@@ -2,6 +2,7 @@
 
 #include <unsupported/Eigen/FFT>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -29,6 +30,13 @@ void FrequencyData::validate() const {
   if (!varY.allFinite() || (varY.array() < 0).any())
     throw std::invalid_argument("varY must be finite and >= 0");
   if (!covYU.allFinite()) throw std::invalid_argument("covYU contains NaN or inf");
+  if (noiseU.size() || noiseY.size()) {
+    if (noiseU.cols() != n || noiseY.cols() != n || noiseU.rows() != noiseY.rows())
+      throw std::invalid_argument("noiseU and noiseY must both have " + std::to_string(n) +
+                                  " columns (lines) and the same rows (realisations)");
+    if (!noiseU.allFinite() || !noiseY.allFinite())
+      throw std::invalid_argument("noiseU, noiseY contain NaN or inf");
+  }
 }
 
 FrequencyData frequency_data_from_periods(const Eigen::MatrixXd& u, const Eigen::MatrixXd& y) {
@@ -101,6 +109,69 @@ FrequencyData frequency_data_from_period_spectra(const Eigen::Ref<const PeriodSp
     d.varU[l] = vu * scale;
     d.varY[l] = vy * scale;
     d.covYU[l] = c * scale;
+  }
+  return d;
+}
+
+FrequencyData frequency_data_from_record_spectra(const Eigen::Ref<const PeriodSpectra>& Up,
+                                                 const Eigen::Ref<const PeriodSpectra>& Yp,
+                                                 const Eigen::Ref<const Eigen::VectorXcd>& Ur,
+                                                 const Eigen::Ref<const Eigen::VectorXcd>& Yr, int n_per_period) {
+  FrequencyData d = frequency_data_from_period_spectra(Up, Yp);  // the checks, the means
+  const int P = d.periods;
+  const Eigen::Index nl = Up.cols();
+  const long N = n_per_period;
+  if (N < 2 || N / 2 + 1 != nl) {
+    throw std::invalid_argument("n_per_period: " + std::to_string(N) + " samples a period do not give the " +
+                                std::to_string(nl) + " lines of Up");
+  }
+  const long nb = long(P) * N / 2 + 1;
+  if (Ur.size() != nb || Yr.size() != nb) {
+    throw std::invalid_argument("Ur, Yr must hold the " + std::to_string(nb) + " bins 0..P N / 2 of the record, got " +
+                                std::to_string(Ur.size()) + " and " + std::to_string(Yr.size()));
+  }
+  if (!Ur.allFinite()) throw std::invalid_argument("Ur contains NaN or inf");
+  if (!Yr.allFinite()) throw std::invalid_argument("Yr contains NaN or inf");
+  const int Q = P - 1;
+  d.noiseU.resize(Q, nl);
+  d.noiseY.resize(Q, nl);
+  // lines whose bins lie strictly inside the half spectrum: 1 .. Lmax - 1, and Lmax for odd N
+  const Eigen::Index last = (N % 2 == 0) ? nl - 2 : nl - 1;
+  const double rq = 1.0 / std::sqrt(double(Q));
+  const int qlo = -((P + 1) / 2) + 1;  // -ceil(P/2) + 1
+  for (Eigen::Index l = 0; l < nl; ++l) {
+    if (l >= 1 && l <= last) {
+      int j = 0;
+      for (int q = qlo; q <= P / 2; ++q) {
+        if (q == 0) continue;
+        const long b = long(l) * P + q;
+        d.noiseU(j, l) = Ur[b] * rq;
+        d.noiseY(j, l) = Yr[b] * rq;
+        ++j;
+      }
+    } else {
+      // Helmert contrasts h_j = (sum_{p<j} x_p - j x_j) / sqrt(j (j + 1)), j = 1..P-1: orthonormal,
+      // sum_j |h_j|^2 = sum_p |x_p - mean|^2; scaled to the variance of the mean
+      const double s = 1.0 / std::sqrt(double(P) * double(P - 1));
+      std::complex<double> cu = 0, cy = 0;
+      for (int jj = 1; jj < P; ++jj) {
+        cu += Up(jj - 1, l);
+        cy += Yp(jj - 1, l);
+        const double h = 1.0 / std::sqrt(double(jj) * double(jj + 1));
+        d.noiseU(jj - 1, l) = (cu - double(jj) * Up(jj, l)) * (h * s);
+        d.noiseY(jj - 1, l) = (cy - double(jj) * Yp(jj, l)) * (h * s);
+      }
+    }
+    double vu = 0, vy = 0;
+    std::complex<double> c = 0;
+    for (int j = 0; j < Q; ++j) {
+      vu += std::norm(d.noiseU(j, l));
+      vy += std::norm(d.noiseY(j, l));
+      c += d.noiseY(j, l) * std::conj(d.noiseU(j, l));
+    }
+    d.varU[l] = vu;
+    d.varY[l] = vy;
+    d.covYU[l] = c;
   }
   return d;
 }

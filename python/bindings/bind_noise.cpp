@@ -22,6 +22,16 @@ void bind_noise(py::module_& m) {
       }, "Up"_a, "Yp"_a,
         "The statistics of from_periods from the periods' spectra: Up, Yp of shape (P, lines), row p "
         "the spectrum of period p (fft / N) on lines 0..Lmax.")
+      .def_static("from_record_spectra", [](const Eigen::Ref<const lptv::PeriodSpectra>& Up,
+                                            const Eigen::Ref<const lptv::PeriodSpectra>& Yp,
+                                            const Eigen::Ref<const Eigen::VectorXcd>& Ur,
+                                            const Eigen::Ref<const Eigen::VectorXcd>& Yr, int n_per_period) {
+        return lptv::frequency_data_from_record_spectra(Up, Yp, Ur, Yr, n_per_period);
+      }, "Up"_a, "Yp"_a, "Ur"_a, "Yr"_a, "n_per_period"_a,
+        "The statistics from the record's bins between the lines (METHOD.md section 20): Up, Yp the "
+        "periods' spectra (P, lines), Ur, Yr the rfft of the P periods concatenated / (P N).")
+      .def_readonly("noiseU", &lptv::FrequencyData::noiseU)
+      .def_readonly("noiseY", &lptv::FrequencyData::noiseY)
       .def_readonly("U", &lptv::FrequencyData::U)
       .def_readonly("Y", &lptv::FrequencyData::Y)
       .def_readonly("varU", &lptv::FrequencyData::varU)

@@ -81,6 +81,11 @@ class FrequencyData:
     @staticmethod
     def from_periods(u: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], y: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> FrequencyData:
         ...
+    @staticmethod
+    def from_record_spectra(Up: typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]", "flags.c_contiguous"], Yp: typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]", "flags.c_contiguous"], Ur: typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"], Yr: typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, 1]"], n_per_period: typing.SupportsInt | typing.SupportsIndex) -> FrequencyData:
+        """
+        The statistics from the record's bins between the lines (METHOD.md section 20): Up, Yp the periods' spectra (P, lines), Ur, Yr the rfft of the P periods concatenated / (P N).
+        """
     def __init__(self, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], varU: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], varY: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], covYU: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
     @property
@@ -94,6 +99,12 @@ class FrequencyData:
         ...
     @property
     def max_line(self) -> int:
+        ...
+    @property
+    def noiseU(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
+    @property
+    def noiseY(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
         ...
     @property
     def periods(self) -> int:

@@ -1,6 +1,7 @@
 """Frequency data with its nonparametric noise model (METHOD.md section 4)."""
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
@@ -96,8 +97,13 @@ class FrequencyData:
         self.w0 = float(w0)
         self.ts = None if ts is None else float(ts)
 
+    statistics = "given"
+    """Where the (co)variances came from: 'periods' (the periods' sample statistics, section 4 of
+    METHOD.md), 'record' (the whole record's bins between the lines, section 20) or 'given'."""
+
     @classmethod
-    def from_periods(cls, u, y, *, w0: float, ts: Optional[float] = None) -> "FrequencyData":
+    def from_periods(cls, u, y, *, w0: float, ts: Optional[float] = None,
+                     statistics: str = "periods") -> "FrequencyData":
         """Spectra and noise statistics from P >= 2 steady-state periods.
 
         Parameters
@@ -108,7 +114,25 @@ class FrequencyData:
             Fundamental of the period (rad/s); line l is the frequency l * w0.
         ts : float, optional
             Sample period for a discrete-time model (N * ts * w0 = 2 pi).
+        statistics : {'periods', 'record'}
+            'periods' (default): each line's sample (co)variances over the periods (METHOD.md
+            section 4). 'record': from the bins between the lines of the whole record's DFT
+            (METHOD.md section 20), right also when the noise is the system's response to a
+            disturbance that does not repeat (its leakage telescopes there as in the mean);
+            the data then hold the noise's realisations (``noise_realisations``). The means
+            are the same.
+
+        Examples
+        --------
+        >>> import numpy as np, lptv
+        >>> rng = np.random.default_rng(0)
+        >>> u = rng.standard_normal((4, 64)); y = 2 * u + 0.1 * rng.standard_normal((4, 64))
+        >>> d = lptv.FrequencyData.from_periods(u, y, w0=1.0, statistics="record")
+        >>> d.statistics, d.noise_realisations[0].shape
+        ('record', (3, 33))
         """
+        if not isinstance(statistics, str) or statistics not in ("periods", "record"):
+            raise ValueError(f"statistics must be 'periods' or 'record', got {statistics!r}")
         w0, ts = cls._check(w0, ts)
         u = _periods_array(u, "u")
         y = _periods_array(y, "y")
@@ -131,8 +155,39 @@ class FrequencyData:
         Yp = np.fft.rfft(y, axis=1)
         Yp *= 1.0 / n
         obj = cls.__new__(cls)
-        obj._set(_core.FrequencyData.from_period_spectra(Up, Yp), w0, ts)
+        if statistics == "record":
+            P = u.shape[0]
+            Ur = np.fft.rfft(u.reshape(-1))
+            Ur *= 1.0 / (P * n)
+            Yr = np.fft.rfft(y.reshape(-1))
+            Yr *= 1.0 / (P * n)
+            obj._set(_core.FrequencyData.from_record_spectra(Up, Yp, Ur, Yr, n), w0, ts)
+        else:
+            obj._set(_core.FrequencyData.from_period_spectra(Up, Yp), w0, ts)
+        obj.statistics = statistics
+        obj._spectra = (Up, Yp)
+        obj._record = (u, y)
         return obj
+
+    def record_statistics(self) -> "FrequencyData":
+        """These data with the (co)variances from the whole record's bins between the lines
+        (``statistics='record'``, METHOD.md section 20); needs data made by :meth:`from_periods`."""
+        if self.statistics == "record":
+            return self
+        rec = getattr(self, "_record", None)
+        if rec is None:
+            raise ValueError("the record's statistics need the periods: make the data with "
+                             "FrequencyData.from_periods(u, y, ...)")
+        return FrequencyData.from_periods(rec[0], rec[1], w0=self.w0, ts=self.ts, statistics="record")
+
+    @property
+    def noise_realisations(self):
+        """(noiseU, noiseY), each (P - 1, lines): realisations of the means' noise whose sums of
+        squares are the (co)variances (``statistics='record'``), else None."""
+        nu = np.asarray(self._cpp.noiseU)
+        if nu.size == 0:
+            return None
+        return nu, np.asarray(self._cpp.noiseY)
 
     U = property(lambda self: np.asarray(self._cpp.U), doc="Mean input spectrum, lines 0..Lmax.")
     Y = property(lambda self: np.asarray(self._cpp.Y), doc="Mean output spectrum.")
@@ -203,3 +258,93 @@ def experiments_of(items, w0, ts) -> list:
             raise ValueError(f"experiments disagree on the sample period of the discrete-time model: "
                              f"experiments[0] has ts = {first.ts:g}, experiments[{i}] has ts = {d.ts:g}")
     return datas
+
+
+LINES_ALPHA = 0.01
+"""The size of :func:`correlated_lines` over its two channels (Bonferroni)."""
+
+
+@dataclass(frozen=True)
+class LineCorrelation:
+    """The test of :func:`correlated_lines`: for the input and the output, the lag-1 and lag-2
+    sums of the periods' normalised deviations' inner products between lines, their chi-square
+    statistic (4 degrees of freedom) and p-value; ``correlated`` when either p-value is below
+    ``LINES_ALPHA / 2``."""
+
+    correlated: bool
+    statistic: tuple
+    p_value: tuple
+    pairs: int
+    reason: str
+
+
+def correlated_lines(d, alpha: float = LINES_ALPHA) -> LineCorrelation:
+    """Whether the noise of neighbouring lines is correlated in the periods (METHOD.md section 20).
+
+    Per channel X (input, output) and line l = 1 .. Lmax - 1, the deviations of the P periods'
+    spectra from their mean, v_l in C^P, and c_l^(k) = <v_l, v_{l+k}> / (|v_l| |v_{l+k}|) for the
+    lags k = 1, 2. Noise independent from line to line leaves the directions of the v_l
+    independent and uniform in the (P - 1)-dimensional space of deviations, so
+    S_k = sum_l c_l^(k) has mean 0 and E|S_k|^2 = n_k / (P - 1), the terms uncorrelated; then
+    X^2 = 2 (P - 1) (|S_1|^2 / n_1 + |S_2|^2 / n_2) is about chi-square with 4 degrees of freedom.
+    A disturbance whose response does not repeat leaks into every period's lines as a smooth
+    term, and one filtered by a periodically time-varying system correlates the lines l and
+    l +- k: both make the deviations of neighbouring lines alike.
+
+    Parameters
+    ----------
+    d : FrequencyData
+        Data made by :meth:`FrequencyData.from_periods` (the periods' spectra are needed).
+    alpha : float
+        The test's size over both channels.
+
+    Examples
+    --------
+    >>> import numpy as np, lptv
+    >>> rng = np.random.default_rng(1)
+    >>> u = rng.standard_normal((8, 256)); y = u + 0.1 * rng.standard_normal((8, 256))
+    >>> lptv.data.correlated_lines(lptv.FrequencyData.from_periods(u, y, w0=1.0)).correlated
+    False
+    """
+    alpha = as_float(alpha, "alpha", minimum=0.0, open_min=True)
+    spectra = getattr(d, "_spectra", None)
+    if spectra is None:
+        raise ValueError("d: the test reads the periods' spectra: make the data with from_periods(u, y, ...)")
+    names = getattr(d, "_channel_names", ("the input", "the output"))
+    return line_correlation(spectra, names, alpha)
+
+
+def line_correlation(spectra, names, alpha: float = LINES_ALPHA) -> LineCorrelation:
+    """:func:`correlated_lines` on the periods' spectra of each channel (a sequence of (P, lines)
+    arrays) named by ``names``; Bonferroni over the channels."""
+    from scipy import stats
+
+    P = spectra[0].shape[0]
+    stat, pval, pairs = [], [], 0
+    for X in spectra:
+        V = X[:, 1:-1] - X[:, 1:-1].mean(0)
+        norm = np.sqrt(np.sum(np.abs(V) ** 2, 0))
+        x2 = 0.0
+        for k in (1, 2):
+            a, b = V[:, :-k], V[:, k:]
+            na, nb = norm[:-k], norm[k:]
+            ok = (na > 1e-300) & (nb > 1e-300)
+            n = int(np.count_nonzero(ok))
+            if n < 8:
+                x2 = np.nan
+                break
+            c = np.sum(a[:, ok] * np.conj(b[:, ok]), 0) / (na[ok] * nb[ok])
+            x2 += 2 * (P - 1) * abs(np.sum(c)) ** 2 / n
+            pairs = max(pairs, n)
+        stat.append(float(x2))
+        pval.append(float(stats.chi2.sf(x2, 4)) if np.isfinite(x2) else 1.0)
+    m = len(spectra)
+    hit = [i for i, p in enumerate(pval) if p < alpha / m]
+    if hit:
+        reason = ("the noise of neighbouring lines is correlated in " + " and ".join(names[i] for i in hit)
+                  + " (p = " + ", ".join(f"{pval[i]:.2g}" for i in hit)
+                  + "): a disturbance that passes through the system or does not repeat in the periods")
+    else:
+        reason = ("the noise of neighbouring lines is not correlated (p = "
+                  + ", ".join(f"{p:.2g} in {n}" for p, n in zip(pval, names)) + ")")
+    return LineCorrelation(bool(hit), tuple(stat), tuple(pval), pairs, reason)

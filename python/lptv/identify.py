@@ -16,7 +16,7 @@ from .mimo_identify import identify_mimo, is_mimo
 from .result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
-NOISES = ("auto", "sample", "moderated")
+NOISES = ("auto", "sample", "moderated", "full", "full-moderated")
 # noise='auto' moderates from this many periods: below it the lines that keep their own variance
 # (lines 0 and Lmax, outliers) have 1-4 degrees of freedom, and the checks that read the moderated
 # data's periods for every line (the input's presence, the rows with signal) would misjudge them.
@@ -176,9 +176,14 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         The number of refits for ``covariance='bootstrap'`` (at least 20).
     seed : int, optional
         Seeds the bootstrap's draws.
-    noise : {'auto', 'sample', 'moderated'}
+    noise : {'auto', 'sample', 'moderated', 'full', 'full-moderated'}
         The noise (co)variances the fit weighs by. 'sample': each line's own, from its P
-        periods. 'moderated': each line's combined with its neighbours' by
+        periods. 'full' and 'full-moderated': the same two from the whole record's bins
+        between the lines instead of the periods (METHOD.md section 20:
+        :meth:`FrequencyData.record_statistics`), right also for a disturbance that passes
+        through the system or does not repeat in the periods (its response leaks into every
+        period, and the periods' statistics count that leakage, which the mean does not hold);
+        they need the periods (not FrequencyData made otherwise). 'moderated': each line's combined with its neighbours' by
         :func:`lptv.moderated_noise` (empirical Bayes, METHOD.md section 7), worth about
         1 + nu / 2 periods (nu the lines' median degrees of freedom, often 40-120 at P = 4 when
         the noise spectrum is smooth); the covariance's small-sample factor is taken at those
@@ -189,7 +194,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         'auto' (default): 'moderated' when every experiment has P >= 4 periods and its noise
         spectrum passes the smoothness check of :func:`lptv.moderation.smooth_noise` (prior
         degrees of freedom d0 at least the lines' own 2 (P - 1), at most 10 % of the lines
-        outlying), 'sample' otherwise, and for ``covariance='bootstrap'`` or ``'realisations'`` and the
+        outlying), 'sample' otherwise, each from the whole record ('full-moderated', 'full')
+        when :func:`lptv.data.correlated_lines` finds the periods' noise correlated between
+        neighbouring lines (size 1 %), and 'sample' for ``covariance='bootstrap'`` or ``'realisations'`` and the
         realisations of :meth:`lptv.DistortionResult.experiments`. ``res.noise`` says which
         was used and ``res.noise_choice`` why. ``res.data`` holds the data the fit used.
     disturbances : {None, 'remove'}
@@ -257,8 +264,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         raise ValueError(f"covariance must be one of {COVARIANCES}, got {covariance!r}")
     if not isinstance(noise, str) or noise not in NOISES:
         raise ValueError(f"noise must be one of {NOISES}, got {noise!r}")
-    if noise == "moderated" and covariance == "bootstrap":
-        raise ValueError("noise='moderated' is not for covariance='bootstrap': the bootstrap draws P periods "
+    if noise in ("moderated", "full-moderated") and covariance == "bootstrap":
+        raise ValueError(f"noise='{noise}' is not for covariance='bootstrap': the bootstrap draws P periods "
                          "from each line's own sample variances; use covariance='analytic' with moderated noise")
     if disturbances is not None and (not isinstance(disturbances, str) or disturbances != "remove"):
         raise ValueError(f"disturbances must be None or 'remove', got {disturbances!r}")
@@ -281,11 +288,23 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ts = data.ts if ts is None else ts
     moderation = ()
     choice = "asked for"
+    if noise in ("full", "full-moderated"):
+        if several:
+            datas = [_record_data(d, f"experiments[{i}]") for i, d in enumerate(datas)]
+            data = datas[0]
+        else:
+            data = _record_data(data, "u")
     if noise == "auto":
         noise, choice, pairs = _auto_noise(datas if several else [data], covariance)
-    elif noise == "moderated":
+        if noise == "full":   # the moderated routes' data come with the pairs
+            if several:
+                datas = [d.record_statistics() for d in datas]
+                data = datas[0]
+            else:
+                data = data.record_statistics()
+    elif noise in ("moderated", "full-moderated"):
         pairs = [_moderated(d) for d in (datas if several else [data])]
-    if noise == "moderated":
+    if noise in ("moderated", "full-moderated"):
         moderation = tuple(m for _, m in pairs)
         if several:
             datas = [d for d, _ in pairs]
@@ -386,30 +405,61 @@ def _without_disturbances(u, y, several):
     return items, None, tuple(found)
 
 
+def _record_data(d, name):
+    """The data with the record's statistics (noise='full...'), or a ValueError naming ``name``."""
+    try:
+        return d.record_statistics()
+    except ValueError as e:
+        raise ValueError(f"noise='full' takes the noise from the whole record: {name}: {e}") from None
+
+
 def _auto_noise(datas, covariance):
-    """noise='auto': ('moderated' or 'sample', the sentence saying why, the moderated data and
-    their ModeratedNoise per experiment for 'moderated', else None)."""
+    """noise='auto': ('sample', 'moderated', 'full' or 'full-moderated', the sentence saying why,
+    the moderated data and their ModeratedNoise per experiment for a moderated route, else None).
+
+    First the statistics: the whole record's (the 'full' routes, METHOD.md section 20) when the
+    periods' noise is correlated between neighbouring lines (:func:`lptv.data.correlated_lines`)
+    in any experiment, else the periods'; then the moderation, as before, on those statistics.
+    The sentence keeps the moderation's reason first and adds the test's."""
+    from .data import correlated_lines
     from .moderation import moderated_noise, smooth_noise
 
     if covariance in ("bootstrap", "realisations"):
         return "sample", f"the sample variances: covariance='{covariance}' resamples them", None
     if any(getattr(d, "distortion", None) is not None for d in datas):
         return "sample", "the sample variances: the data are realisations of lptv.distortion", None
+    if any(d.periods < 2 for d in datas):
+        return "sample", "the sample variances: the data do not come from periods", None
+    full, lines = False, ""
+    if all(d.statistics == "record" for d in datas):
+        full, lines = True, "the noise from the whole record (the data's statistics)"
+    elif all(getattr(d, "_record", None) is not None for d in datas):
+        tests = [correlated_lines(d) for d in datas]
+        full = any(t.correlated for t in tests)
+        said = [t.reason for t in tests if t.correlated == full]
+        where = [i for i, t in enumerate(tests) if t.correlated == full]
+        if len(datas) > 1:
+            said = [f"experiment {i}: {r}" for i, r in zip(where, said)]
+        lines = "; ".join(said[:3]) + (" (the noise from the whole record)" if full else "")
+        datas = [d.record_statistics() for d in datas] if full else datas
+    sample, moderated = ("full", "full-moderated") if full else ("sample", "moderated")
+
+    def say(head, why):
+        return f"{head}: {why}" + (f"; {lines}" if lines else "")
+
     pairs, why = [], []
     for d in datas:
-        if d.periods < 2:
-            return "sample", "the sample variances: the data do not come from periods", None
         if d.periods < AUTO_MIN_PERIODS:
-            return "sample", (f"the sample variances: {d.periods} periods (the moderated route needs "
-                              f"{AUTO_MIN_PERIODS}: the lines that keep their own variance would have "
-                              f"{2 * (d.periods - 1)} degrees of freedom)"), None
+            return sample, say("the sample variances", (
+                f"{d.periods} periods (the moderated route needs {AUTO_MIN_PERIODS}: the lines that keep "
+                f"their own variance would have {2 * (d.periods - 1)} degrees of freedom)")), None
         mo = moderated_noise(d)
         ok, reason = smooth_noise(mo)
         why.append(reason)
         if not ok:
-            return "sample", "the sample variances: " + reason, None
+            return sample, say("the sample variances", reason), None
         pairs.append(_moderated(d, mo))
-    return "moderated", "moderated: " + "; ".join(why), pairs
+    return moderated, say("moderated", "; ".join(why)), pairs
 
 
 def _moderated(d, mo=None):

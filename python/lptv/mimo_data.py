@@ -61,9 +61,19 @@ class MimoFrequencyData:
     n_outputs = property(lambda self: self.Y.shape[1])
     max_line = property(lambda self: self.U.shape[0] - 1)
 
+    statistics = "given"
+    """'periods', 'record' (METHOD.md section 20) or 'given'."""
+
     @classmethod
-    def from_periods(cls, u, y, *, w0: float, ts: Optional[float] = None) -> "MimoFrequencyData":
-        """From P >= 2 periods: ``u`` of shape (P, N, nu), ``y`` of shape (P, N, ny)."""
+    def from_periods(cls, u, y, *, w0: float, ts: Optional[float] = None,
+                     statistics: str = "periods") -> "MimoFrequencyData":
+        """From P >= 2 periods: ``u`` of shape (P, N, nu), ``y`` of shape (P, N, ny).
+
+        ``statistics='record'``: the covariances of lines 1 .. N/2 - 1 (N/2 too for odd N) from
+        the whole record's P - 1 bins between the lines (METHOD.md section 20), as for one
+        input and output (:meth:`lptv.FrequencyData.from_periods`)."""
+        if not isinstance(statistics, str) or statistics not in ("periods", "record"):
+            raise ValueError(f"statistics must be 'periods' or 'record', got {statistics!r}")
         u = _periods(u, "u")
         y = _periods(y, "y")
         if y.shape[:2] != u.shape[:2]:
@@ -81,7 +91,32 @@ class MimoFrequencyData:
         dz = w - wm
         C = np.einsum("plc,pld->lcd", dz, dz.conj()) / (P * (P - 1))
         ny = y.shape[2]
-        return cls(U=zm[:, ny:].copy(), Y=zm[:, :ny].copy(), C=C, periods=P, w0=_w0(w0), ts=_ts(ts))
+        if statistics == "record":
+            zr = np.concatenate([np.fft.rfft(y.reshape(P * N, -1), axis=0),
+                                 np.fft.rfft(u.reshape(P * N, -1), axis=0)], axis=1) / (P * N)
+            last = N // 2 - 1 if N % 2 == 0 else N // 2
+            qs = np.array([q for q in range(-((P + 1) // 2) + 1, P // 2 + 1) if q != 0])
+            lines = np.arange(1, last + 1)
+            zb = zr[lines[:, None] * P + qs[None, :]]          # (lines, P - 1, channels)
+            C = C.copy()
+            C[lines] = np.einsum("lqc,lqd->lcd", zb, zb.conj()) / (P - 1)
+        out = cls(U=zm[:, ny:].copy(), Y=zm[:, :ny].copy(), C=C, periods=P, w0=_w0(w0), ts=_ts(ts))
+        object.__setattr__(out, "statistics", statistics)
+        object.__setattr__(out, "_spectra", tuple(z[:, :, c] for c in range(z.shape[2])))
+        object.__setattr__(out, "_channel_names", tuple(f"output {i}" for i in range(ny))
+                           + tuple(f"input {i}" for i in range(u.shape[2])))
+        object.__setattr__(out, "_record", (u, y))
+        return out
+
+    def record_statistics(self) -> "MimoFrequencyData":
+        """These data with the covariances from the whole record (``statistics='record'``)."""
+        if self.statistics == "record":
+            return self
+        rec = getattr(self, "_record", None)
+        if rec is None:
+            raise ValueError("the record's statistics need the periods: make the data with "
+                             "MimoFrequencyData.from_periods(u, y, ...)")
+        return MimoFrequencyData.from_periods(rec[0], rec[1], w0=self.w0, ts=self.ts, statistics="record")
 
 
 def _periods(x, name):

@@ -21,8 +21,36 @@ AUTO_MIN_PERIODS = 4
 
 
 def _noise_route(datas, noise):
-    """(route, why, the MimoModeratedNoise per experiment or None) for noise='auto', 'sample' or
-    'moderated' (METHOD.md section 19, "Moderated noise for several channels")."""
+    """(route, why, the MimoModeratedNoise per experiment or None, the data) for noise='auto',
+    'sample', 'moderated', 'full' or 'full-moderated' (METHOD.md sections 19 and 20): the
+    statistics first (the whole record's when asked for, or when noise='auto' finds the periods'
+    noise correlated between neighbouring lines), then the moderation."""
+    full, lines = noise in ("full", "full-moderated"), ""
+    if full:
+        try:
+            datas = [d.record_statistics() for d in datas]
+        except ValueError as e:
+            raise ValueError(f"noise='{noise}' takes the noise from the whole record: {e}") from None
+        noise = "sample" if noise == "full" else "moderated"
+    elif noise == "auto" and all(getattr(d, "_record", None) is not None for d in datas):
+        from .data import correlated_lines
+        tests = [correlated_lines(d) for d in datas]
+        full = any(t.correlated for t in tests)
+        said = [(f"experiment {i}: " if len(datas) > 1 else "") + t.reason
+                for i, t in enumerate(tests) if t.correlated == full]
+        lines = "; ".join(said[:3]) + (" (the noise from the whole record)" if full else "")
+        if full:
+            datas = [d.record_statistics() for d in datas]
+    route, why, mos = _moderation_route(datas, noise)
+    if full:
+        route = {"sample": "full", "moderated": "full-moderated"}[route]
+    if lines:
+        why = why + "; " + lines
+    return route, why, mos, datas
+
+
+def _moderation_route(datas, noise):
+    """(route, why, mos) of the moderation for noise 'auto', 'sample' or 'moderated'."""
     from .moderation import smooth_noise
     from .mimo_moderation import moderated_mimo_noise
 
@@ -154,8 +182,9 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
                   known=None, tol=1e-10, max_iter=50, covariance="analytic",
                   noise="auto") -> MimoIdentificationResult:
     """lptv.identify's route for several inputs or outputs (its docstring has the arguments)."""
-    if not isinstance(noise, str) or noise not in ("auto", "sample", "moderated"):
-        raise ValueError(f"noise must be one of ('auto', 'sample', 'moderated'), got {noise!r}")
+    noises = ("auto", "sample", "moderated", "full", "full-moderated")
+    if not isinstance(noise, str) or noise not in noises:
+        raise ValueError(f"noise must be one of {noises}, got {noise!r}")
     if not isinstance(method, str) or method not in MIMO_METHODS:
         raise ValueError(f"method must be one of {MIMO_METHODS} for several inputs or outputs, got {method!r}")
     if not isinstance(covariance, str) or covariance not in ("analytic", "none"):
@@ -164,8 +193,8 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=1)
     datas = _experiments(u, y, w0, ts)
-    route, choice, mos = _noise_route(datas, noise)
-    if route == "moderated":
+    route, choice, mos, datas = _noise_route(datas, noise)
+    if route in ("moderated", "full-moderated"):
         datas = [m.data for m in mos]
     d0 = datas[0]
     ny, nu = d0.n_outputs, d0.n_inputs

@@ -55,8 +55,9 @@ class MimoIdentificationResult:
     tests: Tuple = field(default=(), repr=False)
     """(row index, output or -1 for the joint test, statistic, p-value) of each residue test."""
     noise: str = "sample"
-    """The noise (co)variances the fit weighed by: 'sample' (each line's own) or 'moderated'
-    (combined with the neighbouring lines', METHOD.md section 19)."""
+    """The noise (co)variances the fit weighed by: 'sample' (each line's own), 'moderated'
+    (combined with the neighbouring lines', METHOD.md section 19), or 'full' and
+    'full-moderated' (the same two from the whole record's bins, METHOD.md section 20)."""
     noise_choice: str = ""
     """Why: 'asked for', or the smoothness check's sentence for noise='auto'."""
     moderation: Tuple = field(default=(), repr=False)

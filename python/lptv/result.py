@@ -443,7 +443,10 @@ class IdentificationResult:
         lines = [
             f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} lines",
         ]
-        if self.noise == "moderated":
+        if self.noise in ("full", "full-moderated"):
+            lines.append("noise: from the whole record's bins between the lines (a disturbance that passes "
+                         "through the system, METHOD.md section 20)")
+        if self.noise in ("moderated", "full-moderated"):
             worth = [("not moderated" if m is None else f"worth about {d.periods} periods per line (prior degrees of freedom d0 = {m.prior_dof:.3g}"
                       + (f", {m.outliers.size} lines kept their own)" if m.outliers.size else ")"))
                      for m, d in zip(self.moderation, self.experiments or (self.data,))]

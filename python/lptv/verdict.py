@@ -177,7 +177,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         if fitted is not None:        # the fit weighed by moderated variances: d holds them
             mo, nu_line = fitted, fitted.dof
             d = mo.unbiased_data()
-        elif MODERATE and P >= 2 and res.noise == "sample":
+        elif MODERATE and P >= 2 and res.noise in ("sample", "full"):
             from .moderation import moderated_noise, smooth_noise
             mo = moderated_noise(d)
             # only a smooth noise spectrum (the check of identify's noise='auto'): bumps a few

@@ -469,8 +469,12 @@ def test_remove_disturbances_option(tmp_path, capsys):
     ref = lptv.identify(u, y, **st, w0=d["w0"], lines=d["lines"], disturbances="remove")
     np.testing.assert_allclose(lptv.Model.load(tmp_path / "o" / "model.json").covariance, ref.covariance,
                                rtol=1e-9, atol=0)
-    rc, out, err = identify_cli(capsys, src, *args, "--out", tmp_path / "o2")
-    # the verdict rejects the fit (residues below the noise): exit status 3
+    # the default takes the whole record's noise (the hum's leakage correlates the periods'
+    # lines, METHOD.md section 20) and keeps the structure
+    rc, out, err = identify_cli(capsys, src, *args, "--out", tmp_path / "o3")
+    assert rc == 0 and "from the whole record" in out, out
+    rc, out, err = identify_cli(capsys, src, *args, "--noise", "sample", "--out", tmp_path / "o2")
+    # on the periods' own variances the verdict rejects the fit (residues below the noise): exit status 3
     assert rc == 3 and "too small" in out and "lptv.disturbances" in out and "hint: " in out
     assert "--remove-disturbances finds and removes it" in out
     rc, out, err = identify_cli(capsys, src, src, *args, "--remove-disturbances")

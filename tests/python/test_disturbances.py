@@ -46,9 +46,15 @@ def test_a_sinusoid_off_the_grid_is_found_removed_and_the_verdict_keeps_the_stru
     assert abs(hum.amplitude / a - 1) < 0.01
     assert np.allclose(out.u, u)                      # nothing in the input
 
-    with_hum = fit(d, u, y_h)
+    # the periods' own variances count the sinusoid's leakage (METHOD.md section 7)
+    with_hum = fit(d, u, y_h, noise="sample")
     assert not with_hum.model_ok
     assert any("too small" in e and "lptv.disturbances" in e for e in with_hum.model_errors)
+    # the default sees the leakage as noise correlated between lines and takes the whole record's
+    # bins, where the leakage is P times narrower (METHOD.md section 20): the structure is kept
+    default = fit(d, u, y_h)
+    assert default.noise.startswith("full"), default.noise_choice
+    assert default.model_ok, default.model_errors
 
     cleaned = fit(d, u, y_h, disturbances="remove")
     assert cleaned.model_ok, cleaned.model_errors
@@ -62,6 +68,8 @@ def test_a_sinusoid_off_the_grid_is_found_removed_and_the_verdict_keeps_the_stru
     v_removed = cleaned.data.varY[near]
     assert np.median(v_hum / v_clean) > 5
     assert 0.8 < np.median(v_removed / v_clean) < 1.25
+    v_record = lptv.FrequencyData.from_periods(u, y_h, w0=d["w0"], statistics="record").varY[near]
+    assert 0.8 < np.median(v_record / v_clean) < 1.25
 
 
 def test_noise_alone_gives_no_disturbance_and_a_sinusoid_on_the_grid_stays():

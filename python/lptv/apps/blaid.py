@@ -53,8 +53,9 @@ def _fail(src, problem) -> int:
 
 def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     M, P, N = meas.u.shape
-    if getattr(args, "noise", "auto") == "moderated":
-        return _fail(src, "--noise moderated is for records of periods, not M x P x N realisations (their "
+    noise = getattr(args, "noise", "auto")
+    if noise in ("moderated", "full", "full-moderated"):
+        return _fail(src, f"--noise {noise} is for records of periods, not M x P x N realisations (their "
                           "variances are the noise's and the nonlinear distortion's, per realisation)")
     covariance = getattr(args, "covariance", "analytic")
     if covariance == "bootstrap":

@@ -73,7 +73,7 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
     rep.figure(fig, "residues.png",
                "Each output's normalised residue |e_p|^2 / C_e[p, p] on the rows of the fit (all experiments), "
                "in dB: about 0 dB (its mean) where the model is right; the dashed line is the 99 % point of "
-               f"F(2, 2(P-1)) for one row (P = {P}{', what the moderated noise is worth' if route == 'moderated' else ''}); the verdict judges every row of every output and all "
+               f"F(2, 2(P-1)) for one row (P = {P}{', what the moderated noise is worth' if route in ('moderated', 'full-moderated') else ''}); the verdict judges every row of every output and all "
                "outputs jointly with Holm's correction, not by this line.")
     plt.close(fig)
 
