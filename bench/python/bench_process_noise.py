@@ -1,6 +1,6 @@
 """Noise that passes through the system (METHOD.md section 20): the verdict and the intervals on
 records of a rig with a disturbance entering before its time-varying dynamics, in open loop and
-under proportional feedback, simulated by SciPy's solve_ivp (process_rig.py), never by lptv.
+under proportional feedback, simulated by SciPy's solve_ivp (tests/python/process_rig.py), never by lptv.
 
 Per cell (loop, P, disturbance level) R records, each fitted with the true structure by WGTLS
 and SML on three noise routes: 'sample' (the periods' per-line variances, section 4), 'full'
@@ -23,8 +23,8 @@ import warnings
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import process_rig as pr  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "python"))
+import process_rig as pr  # noqa: E402  (tests/python/process_rig.py: the rig by solve_ivp)
 
 import lptv  # noqa: E402
 

@@ -1,4 +1,5 @@
-"""Records of a rig with a disturbance that passes through the system, simulated outside lptv.
+"""Records of a rig with a disturbance that passes through the system, simulated outside lptv
+(shared by tests/python/test_process_noise.py and bench/python/bench_process_noise.py).
 
 The rig: m x'' + c x' + k(t) x = F + d, k(t) = k0 (1 + 0.25 cos w0 t), m = 1 kg, c = 1 N s/m,
 k0 = 30 N/m (a mode at 5.5 rad/s), T0 = 4 s, sampled at 32 Hz (N = 128 a period). The reference
