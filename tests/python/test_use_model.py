@@ -68,6 +68,9 @@ def test_a_model_validates_on_a_second_record_of_its_rig(rig, fitted, capsys, tm
     assert s["fit_percent"]["displacement [m]"] >= 95.0
     assert (tmp_path / "v" / "report.html").stat().st_size > 0
     assert not any(c["changed"] for c in s["coefficient_tests"])
+    # the fit's structure (a0 with one harmonic, a1, b0; a2 the normalised one), its covariance counted
+    assert [c["coefficient"] for c in s["coefficient_tests"]] == ["a0", "a1", "b0"]
+    assert s["notes"] == []
 
 
 def test_a_model_is_refused_on_the_rig_with_a_stiffer_spring(rig, fitted, capsys, tmp_path):

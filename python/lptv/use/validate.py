@@ -215,6 +215,42 @@ def _free_covariance(model, par, free):
     return np.asarray(cov)[np.ix_(idx, idx)], True
 
 
+def _fitted_counts(model):
+    """(ka, kb) per coefficient as the fit had them: from the covariance's parameter names, else
+    the context's structure; None when neither says (the model's arrays then give them)."""
+    names = list(getattr(model, "eta_names", ()) or ())
+    if names:
+        ka, kb = [0] * (model.na + 1), [0] * (model.nb + 1)
+        for n in names:
+            coef, _, part = n.partition(".")
+            k = int(part[2:]) if part[:2] in ("re", "im") and part[2:].isdigit() else 0
+            (ka if coef[0] == "a" else kb)[int(coef[1:])] = max(k, (ka if coef[0] == "a" else kb)[int(coef[1:])])
+        return ka, kb
+    ctx = getattr(model, "context", None)
+    if ctx:
+        s = ctx["structure"]
+        return tuple(x if isinstance(x, list) else [x] * (n + 1) for x, n in ((s["ka"], model.na), (s["kb"], model.nb)))
+    return None
+
+
+def _parametrisation(model):
+    """The fit's parametrisation (its harmonic counts per coefficient) when the model's arrays
+    hold nothing beyond it, else the one the arrays' shape gives."""
+    counts = _fitted_counts(model)
+    if counts is not None:
+        ka, kb = counts
+        outside = False
+        for c, ks in ((model.a, ka), (model.b, kb)):
+            K = (c.shape[1] - 1) // 2
+            for n, k in enumerate(ks):
+                row = np.delete(c[n], np.arange(K - k, K + k + 1))
+                outside |= bool(np.any(row != 0))
+        if not outside:
+            return _core.Parametrisation(model.na, model.nb, list(ka), list(kb), [], model.w0,
+                                         model.ts if model.discrete else 0.0)
+    return _core.Parametrisation(_core.Structure.of(model._cpp))
+
+
 def _siso(model, u, y, lines):
     from ..data import FrequencyData
     from ..validation import normalized_residue
@@ -222,8 +258,8 @@ def _siso(model, u, y, lines):
 
     d = FrequencyData.from_periods(u, y, w0=model.w0, ts=model.ts)
     rows = _rows(model, d.max_line, lines)
-    structure = _core.Structure.of(model._cpp)
-    par = _core.Parametrisation(structure)
+    par = _parametrisation(model)
+    structure = par.structure
     theta = np.asarray(par.theta_from_model(model._cpp))
     e, var_e, r = normalized_residue(model, d, rows)
     free = [i for i in range(np.asarray(par.T).shape[1]) if i != par.norm_index]
