@@ -21,6 +21,8 @@ The public API:
 - :func:`select` - the orders and harmonic count from the data (a ranked grid of structures);
 - :func:`floquet` - characteristic multipliers and Floquet exponents: is the periodic system stable;
 - :func:`normalized_residue`, :func:`frozen_poles`, :func:`frozen_zeros` - validation;
+- :func:`predict`, :func:`validate` - a saved model used: its output for an input (from rest or
+  in steady state), and the model fixed against a fresh record (:mod:`lptv.use`);
 - :func:`montecarlo`, :func:`identify_many` - Monte Carlo studies and many records at once, on
   local processes or a Dask cluster (:mod:`lptv.batch`);
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
@@ -52,6 +54,7 @@ from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_line
 from .moderation import ModeratedNoise, moderated_noise
 from .disturbances import Disturbance, DisturbanceResult, disturbances
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
+from .use import CoefficientTest, ValidationResult, predict, validate
 
 __version__ = "0.1.0"
 
@@ -67,4 +70,5 @@ __all__ = [
     "Disturbance", "DisturbanceResult", "disturbances", "Inspection", "LineClass", "inspect",
     "MimoModel", "MimoMultisines", "mimo_multisines", "MimoHtfEstimate", "mimo_htf_estimate",
     "MimoFrequencyData", "MimoIdentificationResult", "MimoCramerRaoBound", "mimo_crb",
+    "predict", "validate", "ValidationResult", "CoefficientTest",
 ]

@@ -13,7 +13,8 @@ from .model import Model, _short, _ts, _w0
 
 FORMAT_VERSION = 1
 """The version of the JSON description :meth:`MimoModel.to_dict` writes and :meth:`MimoModel.from_dict` reads."""
-_FIELDS = ("format", "version", "n_outputs", "n_inputs", "w0", "ts", "a_real", "a_imag", "b_real", "b_imag")
+_FIELDS = ("format", "version", "n_outputs", "n_inputs", "w0", "ts", "a_real", "a_imag", "b_real", "b_imag",
+           "context")
 
 
 def _as_coefficients(x, name, rows=None):
@@ -207,9 +208,12 @@ class MimoModel:
         v = self._cpp.b_at(as_real_1d(t, "t"))
         return v.reshape(-1, self.nb + 1, self.n_outputs, self.n_inputs)
 
+    context = None
+    """What the model was fitted to, as :attr:`lptv.Model.context` (:mod:`lptv.use.modelfile`)."""
+
     # -- persistence -------------------------------------------------------------
     def to_dict(self) -> dict:
-        return {
+        d = {
             "format": "lptv.MimoModel",
             "version": FORMAT_VERSION,
             "n_outputs": self.n_outputs,
@@ -221,6 +225,9 @@ class MimoModel:
             "b_real": self.b.real.tolist(),
             "b_imag": self.b.imag.tolist(),
         }
+        if self.context is not None:
+            d["context"] = dict(self.context)
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "MimoModel":
@@ -266,9 +273,14 @@ class MimoModel:
                 raise ValueError(f"{what}: {side}_imag must have the shape of {side}_real "
                                  f"{parts[f'{side}_real'].shape}, got {parts[f'{side}_imag'].shape}")
         try:
-            return cls(parts["a_real"] + 1j * parts["a_imag"], parts["b_real"] + 1j * parts["b_imag"], w0=w0, ts=ts)
+            m = cls(parts["a_real"] + 1j * parts["a_imag"], parts["b_real"] + 1j * parts["b_imag"], w0=w0, ts=ts)
+            if "context" in d:
+                from .use.modelfile import check_context
+
+                m.context = check_context(d["context"], m)
         except ValueError as e:
             raise ValueError(f"{what}: {e}") from None
+        return m
 
     def save(self, path) -> None:
         """Write the model as JSON (readable by :meth:`MimoModel.load`)."""

@@ -12,7 +12,8 @@ from ._validate import as_complex_2d, as_float, as_int, as_path, as_real_1d, loa
 
 FORMAT_VERSION = 1
 """The version of the JSON description :meth:`Model.to_dict` writes and :meth:`Model.from_dict` reads."""
-_FIELDS = ("format", "version", "w0", "ts", "a_real", "a_imag", "b_real", "b_imag", "eta_names", "covariance")
+_FIELDS = ("format", "version", "w0", "ts", "a_real", "a_imag", "b_real", "b_imag", "eta_names", "covariance",
+           "context")
 
 
 def _w0(w0):
@@ -61,6 +62,10 @@ class Model:
     for WGTLS and SML and kept by :meth:`save` / :meth:`load`; None otherwise."""
     eta_names = ()
     """Names of the parameters the covariance is about, e.g. 'a0.re1' (Re of harmonic 1 of a_0)."""
+    context = None
+    """What the model was fitted to (channels and units, sampling, period, structure, estimator,
+    noise route), set by ``lptv identify`` and kept by :meth:`save` / :meth:`load` for ``lptv
+    validate`` and ``lptv simulate`` (:mod:`lptv.use.modelfile`); None otherwise."""
 
     def __init__(self, a, b, w0: float, ts: Optional[float] = None):
         a = as_complex_2d(a, "a")
@@ -127,10 +132,30 @@ class Model:
             return scipy.signal.dlti(num, den, dt=self.ts)
         return scipy.signal.lti(num, den)
 
+    def to_scipy(self):
+        """The LTI model as a :class:`scipy.signal.lti` (continuous) or :class:`scipy.signal.dlti`
+        (``dt = ts``); an LPTV model is refused with the reason (a ValueError).
+
+        Examples
+        --------
+        >>> import numpy as np, lptv
+        >>> m = lptv.Model.from_tf([2.0], [1.0, 3.0])
+        >>> w, H = m.to_scipy().freqresp([1.0])
+        >>> bool(np.isclose(H[0], 2 / (1j + 3), rtol=1e-14))
+        True
+        """
+        from .use.export import to_scipy
+
+        return to_scipy(self)
+
     def to_control(self, t: Optional[float] = None):
         """A python-control ``TransferFunction`` (``control.tf``; ``dt = ts`` in discrete time) of the
-        LTI model or of the frozen system at time ``t``. Needs the optional extra
-        ``pip install 'lptv[control]'``."""
+        LTI model or of the frozen system at time ``t``; an LPTV model without ``t`` is refused with
+        the reason (a ValueError). Needs the optional extra ``pip install 'lptv[control]'``."""
+        if t is None:
+            from .use.export import refuse_lptv
+
+            refuse_lptv(self, "to_control")
         try:
             import control
         except ImportError:
@@ -258,6 +283,8 @@ class Model:
         if self.covariance is not None:
             d["eta_names"] = list(self.eta_names)
             d["covariance"] = np.asarray(self.covariance).tolist()
+        if self.context is not None:
+            d["context"] = dict(self.context)
         return d
 
     def _to_dict(self) -> dict:
@@ -331,6 +358,13 @@ class Model:
             if not np.all(np.isfinite(cov)):
                 raise ValueError("lptv.Model description: covariance contains NaN or inf")
             m.covariance, m.eta_names = cov, tuple(names)
+        if "context" in d:
+            from .use.modelfile import check_context
+
+            try:
+                m.context = check_context(d["context"], m)
+            except ValueError as e:
+                raise ValueError(f"lptv.Model description: {e}") from None
         return m
 
     def save(self, path) -> None:

@@ -248,6 +248,8 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     PiS = X @ (WJ.T @ S)                                       # Pi S
     G = WJ.T @ S @ WJ
     Sr = S - PiS - PiS.T + X @ G @ X.T
+    if getattr(res, "fixed_covariance", None) is not None:   # lptv.validate: a model not fitted to these data
+        Sr = S + Jc @ res.fixed_covariance @ Jc.T          # r = r0 - J delta, delta its own error (METHOD.md 21)
     m = order.size
     blocks = Sr.reshape(m, 2, m, 2)
     ii = np.arange(m)

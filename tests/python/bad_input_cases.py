@@ -852,6 +852,16 @@ def python_cases():
         Case("compare-u-str", "type", lambda: lp().compare(fit(), "abc", Y()), match=names("u")),
         Case("compare-y-nan", "nan/inf", lambda: lp().compare(fit(), U(), Y() * NaN), match=names("y")),
         Case("compare-shape", "shape", lambda: lp().compare(fit(), U(), Y()[:, :100]), match=names("u and y")),
+        Case("predict-model-str", "type", lambda: lp().predict("abc", U()[0], fs=1.0), match=names("model")),
+        Case("predict-u-nan", "nan/inf", lambda: lp().predict(fit().model, U()[0] * NaN, fs=1.0), match=names("u")),
+        Case("predict-u-short", "size", lambda: lp().predict(fit().model, U()[0][:1], fs=1.0), match=names("u")),
+        Case("predict-fs-negative", "range", lambda: lp().predict(fit().model, U()[0], fs=-1.0), match=names("fs")),
+        Case("predict-initial-str", "type", lambda: lp().predict(fit().model, U()[0], fs=1.0, initial="warm"),
+             match=names("initial")),
+        Case("validate-model-str", "type", lambda: lp().validate("abc", U(), Y()), match=names("model")),
+        Case("validate-y-nan", "nan/inf", lambda: lp().validate(fit().model, U(), Y() * NaN), match=names("y")),
+        Case("validate-shape", "shape", lambda: lp().validate(fit().model, U(), Y()[:, :100]),
+             match=names("u and y")),
     ]
 
     # batch

@@ -54,7 +54,8 @@ NOT_CALLED_BY_USERS = {"NumericalError", "IdentifiabilityWarning", "TruncationWa
                        "METHODS", "CramerRaoBound", "FloquetResult", "SimulationResult", "RecordCheck",
                        "Measurements", "RecordResult", "ModeratedNoise", "Disturbance", "DisturbanceResult",
                        "LackOfFit", "Inspection", "LineClass", "MimoMultisines",
-                       "MimoHtfEstimate", "MimoIdentificationResult", "MimoCramerRaoBound"}
+                       "MimoHtfEstimate", "MimoIdentificationResult", "MimoCramerRaoBound", "ValidationResult",
+                       "CoefficientTest"}
 
 
 @pytest.mark.parametrize("name", sorted(set(lptv.__all__) - NOT_CALLED_BY_USERS))

@@ -11,7 +11,7 @@ MARKERS = ("lptv.frozen_poles(res.model", "lptv.inspect(", "lptv.read_measuremen
            "records.append(", "lptv.plots.distortion(d)", "lptv.min_crest_multisine(", "transient_record(",
            "continuous=True", 'referred="input"', 'referred="none"', 'disturbances="remove"',
            "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", "res.noise_choice",
-           'u=["f1", "f2"]', "from lptv import floquet, frozen_poles")
+           'u=["f1", "f2"]', "from lptv import floquet, frozen_poles", "lptv.validate(model")
 
 
 def all_text():
@@ -259,6 +259,21 @@ def test_guide_mimo_example_runs(tmp_path, monkeypatch):
     assert np.abs(est.G[:, 1] - G0).max() < 0.05 * np.abs(G0).max()
     z = np.abs(est.G[:, 1] - G0) / np.sqrt(est.variance[:, 1])
     assert z.max() < 6
+
+
+def test_guide_use_the_model_example_runs(tmp_path, monkeypatch, capsys):
+    """A model saved, read back and validated on a second record of its system: consistent, fit
+    above 95 %, no coefficient moved; the steady-state prediction follows that record's output
+    to its noise; the LTI export's response is the transfer function's."""
+    import numpy as np
+
+    ns = run_block("lptv.validate(model", tmp_path, monkeypatch)
+    check, y, second = ns["check"], ns["y_steady"], ns["second"]
+    assert check.model_ok and check.fit_percent[0] >= 95.0 and not check.changed
+    assert capsys.readouterr().out.startswith("the model is consistent with the fresh record")
+    ym = second["y"].ravel()
+    assert np.linalg.norm(y - ym) <= 0.05 * np.linalg.norm(ym - ym.mean())
+    assert abs(ns["H"][0] - 1 / (100 - 100 + 40j)) <= 1e-12 * abs(ns["H"][0])
 
 
 def test_guide_identify_example_runs(tmp_path, monkeypatch):

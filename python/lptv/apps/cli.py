@@ -7,6 +7,8 @@
     lptv identify FILES... [--workers N | --scheduler ADDRESS]   many files, one row each
     lptv identify FILES... --joint --na 2 --nb 1 ...       records of one system, one model
     lptv select FILE --na 1-3 --nb 0-2 [--k 0-4]          choose the orders and harmonic count
+    lptv validate MODEL.json FILE                         a saved model against a fresh record
+    lptv simulate MODEL.json FILE --input NAME            a saved model's output for a file's input
     lptv montecarlo --runs R --periods P --method wgtls,sml [--scheduler ADDRESS]
                                                           a Monte Carlo study of the estimators
 """
@@ -88,6 +90,10 @@ def main(argv=None) -> int:
     from lptv.apps import choose
 
     choose.add_parser(sub)
+    from lptv.apps import simulatefile, validatefile
+
+    validatefile.add_parser(sub)
+    simulatefile.add_parser(sub)
     if not (sys.argv[1:] if argv is None else argv):
         parser.print_help()
         return 0
@@ -146,6 +152,10 @@ def _run(parser, args) -> int:
         return montecarlo.run(args)
     if args.command == "select":
         return choose.run(args)
+    if args.command in ("validate", "simulate"):
+        from lptv.apps import simulatefile, validatefile
+
+        return (validatefile if args.command == "validate" else simulatefile).run(args)
     parser.error(f"unknown command {args.command}")
     return 2
 

@@ -27,6 +27,7 @@ from lptv import NumericalError, identify_record, read_measurements
 from lptv.apps.options import in_option_terms, integer, output_folder
 from lptv.apps.report import Report, write_json
 from lptv.measurements import FileError
+from lptv.use.modelfile import context_of
 
 MODEL_ERRORS = 3
 
@@ -100,6 +101,9 @@ def run(args, names=None) -> int:
         print(f"  {name:<{width}}  {v: .6g}" + (f" +- {s:.3g}" if s > 0 else "  (normalisation)"))
     for msg in list(res.warnings) + extra:
         print(f"  warning: {msg}")
+    res.model.context = context_of({"route": "one record", "input": meas.input, "output": meas.output, "fs": meas.fs,
+                                    "samples_per_period": N0, "ka": ka, "kb": kb, "method": "output error",
+                                    "noise": "residual"}, res.model)
     res.model.save(out / "model.json")
     write_json(out / "summary.json", {
         "file": str(src), "route": "one record", "periods": L, "samples_per_period": N0, "fs": meas.fs,

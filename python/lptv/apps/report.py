@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv.atomic import atomic_open
+from lptv.use.modelfile import context_of
 
 
 class Report:
@@ -118,6 +119,7 @@ def write_fit(out, model, summary, report):
     out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
+        model.context = context_of(summary, model)      # what lptv validate / simulate read back
         model.save(out / "model.json")
         write_json(out / "summary.json", summary)
         if report is not None:
