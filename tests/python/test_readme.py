@@ -11,7 +11,8 @@ MARKERS = ("lptv.frozen_poles(res.model", "lptv.inspect(", "lptv.read_measuremen
            "records.append(", "lptv.plots.distortion(d)", "lptv.min_crest_multisine(", "transient_record(",
            "continuous=True", 'referred="input"', 'referred="none"', 'disturbances="remove"',
            "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", "res.noise_choice",
-           'u=["f1", "f2"]', "from lptv import floquet, frozen_poles", "lptv.validate(model")
+           'u=["f1", "f2"]', "from lptv import floquet, frozen_poles", "lptv.validate(model",
+           "kp * (r(t) - x)")
 
 
 def all_text():
@@ -317,3 +318,18 @@ def test_guide_stability_of_several_outputs_runs(tmp_path, monkeypatch):
     f, poles = ns["f"], ns["poles"]
     assert poles.shape == (50, 4) and poles.real.max() < 0
     assert not f.is_stable and round(f.spectral_radius, 4) == 1.0273
+
+
+def test_guide_feedback_example_runs(tmp_path, monkeypatch, capsys):
+    """The closed-loop rig integrated by solve_ivp: the default route takes the record's noise and
+    keeps the true structure, its estimates near the rig's coefficients."""
+    import numpy as np
+
+    ns = run_block("kp * (r(t) - x)", tmp_path, monkeypatch)
+    res = ns["res"]
+    out = capsys.readouterr().out.splitlines()
+    assert res.noise.startswith("full") and out[0] == res.noise
+    assert res.model_ok and out[1].startswith("the model is consistent with the noise")
+    truth = np.array([30.0, 3.75, 0.0, 1.0, 1.0, 1.0])
+    free = res.parameter_std > 0
+    assert np.all(np.abs(res.eta - truth)[free] < 4 * res.parameter_std[free])
