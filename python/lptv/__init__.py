@@ -34,12 +34,12 @@ from .uncertainty import CramerRaoBound, crb
 from .nonparametric import HtfEstimate, htf_estimate
 from .distortion import DistortionResult, LackOfFit, distortion
 from .record import RecordResult, identify_record
-from .floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
+from .model.floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
 from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
 from .inspection import Inspection, LineClass, inspect
-from .model import Model
-from .mimo import MimoModel
+from .model.siso import Model
+from .model.mimo import MimoModel
 from .mimo_multisine import MimoMultisines, mimo_multisines
 from .mimo_htf import MimoHtfEstimate, mimo_htf_estimate
 from .mimo_data import MimoFrequencyData

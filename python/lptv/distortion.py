@@ -341,7 +341,7 @@ class DistortionResult:
             A first fit of the best linear approximation (e.g. of :meth:`experiments`): its
             branches refer the output level to the input.
         """
-        from .model import Model
+        from .model.siso import Model
 
         width = as_int(width, "width")
         m = getattr(model, "model", model)
@@ -452,7 +452,7 @@ class DistortionResult:
         """
         from scipy import stats
 
-        from .model import Model
+        from .model.siso import Model
 
         m = getattr(model, "model", model)
         if not isinstance(m, Model):

@@ -25,7 +25,7 @@ import numpy as np
 
 from ._validate import as_int
 from .fds import simulate
-from .model import Model
+from .model.siso import Model
 from .multisine import multisine, time_signal
 
 PAPER_W0 = 0.04

@@ -9,8 +9,8 @@ import numpy as np
 
 from . import _core
 from .data import FrequencyData, experiments_of, frequency_data_of
-from .floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
-from .model import Model
+from .model.floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
+from .model.siso import Model
 from ._validate import INT_MAX, as_counts, as_float, as_int, as_lines
 from .mimo_identify import identify_mimo, is_mimo
 from .result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here

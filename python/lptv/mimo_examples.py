@@ -16,7 +16,7 @@ from typing import Callable, Dict, Tuple
 
 import numpy as np
 
-from .mimo import MimoModel
+from .model.mimo import MimoModel
 
 W0 = 1.0
 RTOL, ATOL = 1e-12, 1e-14

@@ -10,7 +10,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from ._validate import _array, as_float, as_int, as_lines, check_finite
-from .mimo import MimoModel
+from .model.mimo import MimoModel
 from .mimo_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
 from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
 from .mimo_result import MimoIdentificationResult, residue_tests

@@ -10,7 +10,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ._validate import as_positive_float
-from .mimo import MimoModel
+from .model.mimo import MimoModel
 
 ALPHA = 0.01
 """Overall size of the residue tests (Holm's combination), as for one input and output."""

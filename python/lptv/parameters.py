@@ -21,7 +21,7 @@ def _source(obj):
     """(model, eta names, eta values, covariance or None) of a result or a model. A result is
     anything with a model, eta_names, eta and covariance (lptv.identify's, identify_record's):
     read by its attributes, so that this module imports no result type (which imports it)."""
-    from .model import Model
+    from .model.siso import Model
 
     if not isinstance(obj, Model) and all(hasattr(obj, a) for a in ("model", "eta_names", "eta", "covariance")) \
             and isinstance(obj.model, Model):
@@ -252,7 +252,7 @@ def format_parameter_table(obj, level: float = 0.95) -> str:
 
 def perturbed_model(model, name: str, delta: float):
     """A copy of ``model`` with the real parameter ``name`` (e.g. 'a0.re1') moved by ``delta``."""
-    from .model import Model
+    from .model.siso import Model
 
     side, n, part, k = _parse(name)
     a, b = model.a.copy(), model.b.copy()

@@ -13,7 +13,7 @@ import numpy as np
 from . import _core
 from .data import FrequencyData
 from ._validate import as_positive_float
-from .model import Model
+from .model.siso import Model
 
 
 class IdentifiabilityWarning(UserWarning):

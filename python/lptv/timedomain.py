@@ -26,8 +26,8 @@ import numpy as np
 
 from ._core import NumericalError  # the exception type only; no computation of the core is used
 from ._validate import as_spectrum, check_finite
-from .floquet import UnstableModelWarning  # the warning class only
-from .model import Model
+from .model.floquet import UnstableModelWarning  # the warning class only
+from .model.siso import Model
 
 __all__ = ["SteadyState", "Response", "periodic_steady_state", "free_response"]
 

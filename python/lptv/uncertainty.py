@@ -10,8 +10,8 @@ from . import _core
 from ._validate import _array, as_int, as_spectrum
 from .fds import simulate
 from .identify import _counts, _known_list, _rows
-from .mimo import MimoModel
-from .model import Model
+from .model.mimo import MimoModel
+from .model.siso import Model
 from .multisine import Multisine
 
 

@@ -5,8 +5,8 @@ import numpy as np
 
 from . import _core
 from ._validate import as_int, as_lines, as_real_1d
-from .mimo import MimoModel
-from .model import Model
+from .model.mimo import MimoModel
+from .model.siso import Model
 
 
 def _structure_of(model: Model):

@@ -467,7 +467,7 @@ def prediction_variance(res, d, rows: np.ndarray, Yp: np.ndarray) -> np.ndarray:
     simulated output (the model is linear in its coefficients; a relative step of 1e-7 leaves
     an error of that order in g); zero without a covariance."""
     from .fds import simulate
-    from .model import Model
+    from .model.siso import Model
 
     cov = res.covariance
     if cov is None or res.structure is None:

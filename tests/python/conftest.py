@@ -251,7 +251,7 @@ def id_tol():
 # ==================================================================================================
 
 # Hill's multipliers against the eigenvalues of the product of matrix exponentials
-# (lptv.floquet.monodromy, sixth order), relative to ||Phi||_2: the product with 2000 steps is
+# (lptv.model.floquet.monodromy, sixth order), relative to ||Phi||_2: the product with 2000 steps is
 # within ~1e-13 ||Phi|| of the exact Phi (the test checks ||Phi_2000 - Phi_4000|| <=
 # FLOQUET_PRODUCT_STEP ||Phi||), eig(Phi) adds about eps ||Phi|| kappa_i with the eigenvalue
 # condition numbers kappa_i <= FLOQUET_KAPPA_MAX (checked), and Hill's exponents carry at

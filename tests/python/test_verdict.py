@@ -131,7 +131,7 @@ def test_prediction_check_counts_input_noise_and_parameter_uncertainty():
 SLOW_HILL = textwrap.dedent("""
     import time, warnings, numpy as np, lptv
     from lptv.examples import paper_measurements
-    from lptv.floquet import stability_check
+    from lptv.model.floquet import stability_check
     # a_4(t) = 1 + 0.95 cos(w0 t): Hill's method took 46 s on this model (M = 256, not converged)
     a = np.zeros((5, 3), complex); a[:, 1] = [1, 2, 2, 1, 1]; a[4, 0] = a[4, 2] = 0.475
     m = lptv.Model(a, [[1.0]], w0=0.04)

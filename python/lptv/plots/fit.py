@@ -130,7 +130,7 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
         Frequency axis in Hz instead of rad/s.
     """
     from ..fds import htf
-    from ..model import Model
+    from ..model.siso import Model
     from ..nonparametric import HtfEstimate
     from .._validate import as_bool, as_int
 

@@ -6,10 +6,10 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from . import _core
-from ._validate import as_int, as_positive_float
+from .. import _core
+from .._validate import as_int, as_positive_float
 from .mimo import MimoModel
-from .model import Model
+from .siso import Model
 
 __all__ = ["FloquetResult", "UnstableModelWarning", "floquet", "monodromy", "stability_check",
            "StabilityUndecidedWarning"]
@@ -190,7 +190,7 @@ def monodromy(model, steps: Optional[int] = 2000) -> np.ndarray:
     Examples
     --------
     >>> import numpy as np, lptv
-    >>> from lptv.floquet import monodromy
+    >>> from lptv.model.floquet import monodromy
     >>> m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=1.0)           # y' + 2 y: mu = exp(-4 pi)
     >>> bool(np.isclose(monodromy(m)[0, 0], np.exp(-4 * np.pi), rtol=1e-12))
     True
@@ -230,7 +230,7 @@ def stability_check(model) -> Tuple[Optional[str], Optional[str]]:
     Examples
     --------
     >>> import numpy as np, lptv
-    >>> from lptv.floquet import stability_check
+    >>> from lptv.model.floquet import stability_check
     >>> from lptv.examples import mathieu_model
     >>> unstable, undecided = stability_check(mathieu_model(eps=0.1))
     >>> unstable[:21], undecided

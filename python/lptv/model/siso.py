@@ -7,8 +7,8 @@ from typing import Optional
 
 import numpy as np
 
-from . import _core
-from ._validate import as_complex_2d, as_float, as_int, as_path, as_real_1d, load_json
+from .. import _core
+from .._validate import as_complex_2d, as_float, as_int, as_path, as_real_1d, load_json
 
 FORMAT_VERSION = 1
 """The version of the JSON description :meth:`Model.to_dict` writes and :meth:`Model.from_dict` reads."""
@@ -335,7 +335,7 @@ class Model:
 
     def save(self, path) -> None:
         """Write the model as JSON (readable by :meth:`Model.load`)."""
-        from .atomic import atomic_open
+        from ..atomic import atomic_open
 
         with atomic_open(as_path(path)) as f:     # whole or not at all
             json.dump(self.to_dict(), f, indent=1)

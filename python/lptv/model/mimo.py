@@ -7,9 +7,9 @@ from typing import Optional
 
 import numpy as np
 
-from . import _core
-from ._validate import _array, as_path, as_real_1d, check_finite, load_json
-from .model import Model, _short, _ts, _w0
+from .. import _core
+from .._validate import _array, as_path, as_real_1d, check_finite, load_json
+from .siso import Model, _short, _ts, _w0
 
 FORMAT_VERSION = 1
 """The version of the JSON description :meth:`MimoModel.to_dict` writes and :meth:`MimoModel.from_dict` reads."""
@@ -272,7 +272,7 @@ class MimoModel:
 
     def save(self, path) -> None:
         """Write the model as JSON (readable by :meth:`MimoModel.load`)."""
-        from .atomic import atomic_open
+        from ..atomic import atomic_open
 
         with atomic_open(as_path(path)) as f:
             json.dump(self.to_dict(), f, indent=1)
