@@ -40,14 +40,14 @@ from .measurements import Measurements, RecordCheck, RecordWarning, check_record
 from .inspection import Inspection, LineClass, inspect
 from .model.siso import Model
 from .model.mimo import MimoModel
-from .mimo_multisine import MimoMultisines, mimo_multisines
+from .excitation.mimo_multisine import MimoMultisines, mimo_multisines
 from .mimo_htf import MimoHtfEstimate, mimo_htf_estimate
 from .mimo_data import MimoFrequencyData
 from .mimo_result import MimoIdentificationResult
 from .mimo_identify import MimoCramerRaoBound, mimo_crb
 from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
-from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
+from .excitation.multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
                         multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
 from .moderation import ModeratedNoise, moderated_noise
 from .disturbances import Disturbance, DisturbanceResult, disturbances

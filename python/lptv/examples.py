@@ -26,7 +26,7 @@ import numpy as np
 from ._validate import as_int
 from .fds import simulate
 from .model.siso import Model
-from .multisine import multisine, time_signal
+from .excitation.multisine import multisine, time_signal
 
 PAPER_W0 = 0.04
 PAPER_N = 2048

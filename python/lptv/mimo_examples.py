@@ -135,7 +135,7 @@ def small_fit():
     """
     from .fds import simulate
     from .identify import identify
-    from .multisine import multisine
+    from .excitation.multisine import multisine
 
     a = np.zeros((2, 2, 2))
     a[1] = np.eye(2)

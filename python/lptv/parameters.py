@@ -316,7 +316,7 @@ def compare(obj, u, y):
     100.0
     """
     from .fds import simulate
-    from .multisine import spectrum, time_signal
+    from .excitation.multisine import spectrum, time_signal
 
     from ._validate import _array, check_finite
 

@@ -12,7 +12,7 @@ from .fds import simulate
 from .identify import _counts, _known_list, _rows
 from .model.mimo import MimoModel
 from .model.siso import Model
-from .multisine import Multisine
+from .excitation.multisine import Multisine
 
 
 @dataclass(frozen=True)

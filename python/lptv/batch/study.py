@@ -20,7 +20,7 @@ from ..examples import noise_variances, noisy_periods
 from ..fds import simulate
 from ..identify import METHODS, identify
 from ..model.siso import Model
-from ..multisine import Multisine, spectrum, time_signal
+from ..excitation.multisine import Multisine, spectrum, time_signal
 from ..uncertainty import CramerRaoBound, crb
 from .executors import Failure, describe_executor, run_tasks
 from .tables import MonteCarloTables

@@ -7,7 +7,7 @@ from typing import Optional
 
 import numpy as np
 
-from ._validate import as_int, as_seed, as_str
+from .._validate import as_int, as_seed, as_str
 from .multisine import _lines_amplitudes, multisine, time_signal
 
 DESIGNS = ("hadamard", "random")

@@ -5,8 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _core
-from ._validate import as_int, as_int_list, as_real_1d, as_seed, as_spectrum
+from .. import _core
+from .._validate import as_int, as_int_list, as_real_1d, as_seed, as_spectrum
 
 
 @dataclass(frozen=True)
