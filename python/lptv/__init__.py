@@ -24,10 +24,10 @@ The public API:
 - :func:`montecarlo`, :func:`identify_many` - Monte Carlo studies and many records at once, on
   local processes or a Dask cluster (:mod:`lptv.batch`);
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
-- :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
+- :mod:`lptv.simulation.timedomain` - time integration with SUNDIALS CVODE.
 """
 from ._core import NumericalError
-from .fds import ConditioningWarning, SimulationResult, TruncationWarning, band_matrices, htf, simulate
+from .simulation.fds import ConditioningWarning, SimulationResult, TruncationWarning, band_matrices, htf, simulate
 from .data import FrequencyData
 from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
 from .uncertainty import CramerRaoBound, crb

@@ -62,7 +62,7 @@ def _reliable_response(m, U):
     None; or None and the reason it cannot be trusted (a NumericalError, a non-finite output, a
     condition above LOF_CONDITION_MAX on some line, a truncation error above
     LOF_TRUNCATION_MAX): the solve's own figures, with its warnings silenced."""
-    from .fds import simulate
+    from .simulation.fds import simulate
 
     try:
         with warnings.catch_warnings():

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validate import as_int
-from .fds import simulate
+from .simulation.fds import simulate
 from .model.siso import Model
 from .excitation.multisine import multisine, time_signal
 
@@ -538,7 +538,7 @@ def continuous_record(model: Model, periods: int = 2, samples_per_period: int = 
     >>> u.shape, round(ts, 4)
     ((2624,), 0.0958)
     """
-    from . import timedomain
+    from .simulation import timedomain
 
     if not isinstance(model, Model) or model.discrete:
         raise ValueError("model must be a continuous-time lptv.Model")

@@ -133,7 +133,7 @@ def small_fit():
     >>> res.model.n_inputs, res.model.n_outputs, res.parameter_names[:2]
     (1, 2, ('a0[0,0].re0', 'a0[0,1].re0'))
     """
-    from .fds import simulate
+    from .simulation.fds import simulate
     from .identify import identify
     from .excitation.multisine import multisine
 

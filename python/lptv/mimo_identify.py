@@ -328,7 +328,7 @@ def mimo_crb(model: MimoModel, inputs, *, noise, periods: int, lines=None, ka=No
     check_finite(C, "noise")
     if np.any(np.real(np.diagonal(C, axis1=1, axis2=2)) < 0):
         raise ValueError("noise must hold non-negative variances, got a negative one")
-    from .fds import simulate
+    from .simulation.fds import simulate
 
     ka = model.a.shape[3] // 2 if ka is None else ka
     kb = model.b.shape[3] // 2 if kb is None else kb

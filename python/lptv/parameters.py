@@ -315,7 +315,7 @@ def compare(obj, u, y):
     >>> round(lptv.compare(m, u, y)["fit"], 9)
     100.0
     """
-    from .fds import simulate
+    from .simulation.fds import simulate
     from .excitation.multisine import spectrum, time_signal
 
     from ._validate import _array, check_finite

@@ -267,7 +267,7 @@ class IdentificationResult:
         datas = self.experiments or ((self.data,) if self.data is not None else ())
         if not datas:
             return None
-        from .fds import simulate
+        from .simulation.fds import simulate
 
         experiment = self.experiment if self.experiments else np.zeros(self.lines.size, int)
         err, noise = [], []

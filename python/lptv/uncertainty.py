@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _core
 from ._validate import _array, as_int, as_spectrum
-from .fds import simulate
+from .simulation.fds import simulate
 from .identify import _counts, _known_list, _rows
 from .model.mimo import MimoModel
 from .model.siso import Model

@@ -441,7 +441,7 @@ def propagated_input_noise(model, d, rows: np.ndarray) -> np.ndarray:
     gives the model's output Y_model = G U (G = A^-1 B, the model's HTF), lines taken as
     independent. Continuous time: the input lines from -W to max(rows) + W with W = 2K + 16
     (the HTF decays away from its diagonal), on a grid with 64 guard lines beyond them."""
-    from .fds import htf
+    from .simulation.fds import htf
 
     varU = np.asarray(d.varU)
     rows = np.asarray(rows, int)
@@ -466,7 +466,7 @@ def prediction_variance(res, d, rows: np.ndarray, Yp: np.ndarray) -> np.ndarray:
     """g_l^H Cov(eta) g_l on ``rows``, g_l = dY_model,l / d eta by forward differences of the
     simulated output (the model is linear in its coefficients; a relative step of 1e-7 leaves
     an error of that order in g); zero without a covariance."""
-    from .fds import simulate
+    from .simulation.fds import simulate
     from .model.siso import Model
 
     cov = res.covariance

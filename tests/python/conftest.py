@@ -262,7 +262,7 @@ FLOQUET_VS_PRODUCT = 1e-10
 FLOQUET_PRODUCT_STEP = 1e-12
 FLOQUET_KAPPA_MAX = 1e3
 
-# The monodromy of lptv.timedomain's CVODE shooting, in units of its rtol, relative to
+# The monodromy of lptv.simulation.timedomain's CVODE shooting, in units of its rtol, relative to
 # ||Phi||_2: CVODE keeps each step's local error below rtol |x| + atol; over one period of a
 # modestly damped model (|mu| >= 0.05, so nothing decays below atol) the global error is a
 # modest multiple of rtol. Measured 1-14 rtol over 8 models at rtol 1e-8, 1e-10, 1e-12.

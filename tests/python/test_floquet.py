@@ -1,7 +1,7 @@
 """Floquet stability (METHOD.md section 12): Hill's method in the core against independent routes.
 
 - the product of short-interval matrix exponentials (lptv.model.floquet.monodromy, continuous time);
-- the monodromy matrix of lptv.timedomain's CVODE shooting (modestly damped models);
+- the monodromy matrix of lptv.simulation.timedomain's CVODE shooting (modestly damped models);
 - the product of the one-step companion matrices in NumPy (discrete time);
 - the poles of LTI models; the damped Mathieu equation's first instability tongue.
 
@@ -19,7 +19,7 @@ import pytest
 import scipy.linalg
 
 import lptv
-import lptv.timedomain as td
+import lptv.simulation.timedomain as td
 from conftest import _coefficient_row  # the random stable coefficient rows the FDS tests use
 from lptv.examples import mathieu_model, noisy_periods
 from lptv.model.floquet import monodromy

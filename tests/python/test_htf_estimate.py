@@ -112,7 +112,7 @@ def test_plot_draws_every_branch_and_the_model():
 def start_up_record(seed, P=8, snr_db=None):
     """A discrete-time record from rest (a start-up transient in the first periods): a constant
     denominator and one harmonic on the numerator, so the branches -1..1 are exact."""
-    import lptv.timedomain as td
+    import lptv.simulation.timedomain as td
 
     model = random_model(seed, "dt", ka=0, kb=1)
     N = model.samples_per_period

@@ -60,7 +60,7 @@ def run(args) -> int:
          f"N = {PAPER_N}, crest factor {data['multisine'].crest_factor:.2f}")
 
     # --- FDS against CVODE (Fig. 2) ---
-    from lptv import timedomain
+    from lptv.simulation import timedomain
 
     Y_fds, t_fds = _time_fds(model, U0)
     ss = timedomain.periodic_steady_state(model, U0, PAPER_N, full_output=True)

@@ -17,7 +17,7 @@ import numpy as np
 from .._validate import as_float, as_int, as_path, as_real_1d
 from ..data import FrequencyData
 from ..examples import noise_variances, noisy_periods
-from ..fds import simulate
+from ..simulation.fds import simulate
 from ..identify import METHODS, identify
 from ..model.siso import Model
 from ..excitation.multisine import Multisine, spectrum, time_signal

@@ -129,7 +129,7 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
     hz : bool
         Frequency axis in Hz instead of rad/s.
     """
-    from ..fds import htf
+    from ..simulation.fds import htf
     from ..model.siso import Model
     from ..nonparametric import HtfEstimate
     from .._validate import as_bool, as_int
@@ -350,7 +350,7 @@ def _predicted_ratio(res, d, rows):
     with the standard deviations of its magnitude and phase (rad) from the parameter covariance
     (central differences of the simulated output over the parameters, first order); the stds are
     None without a covariance."""
-    from ..fds import simulate
+    from ..simulation.fds import simulate
     from ..parameters import perturbed_model
 
     model = res.model

@@ -6,9 +6,9 @@ import warnings
 
 import numpy as np
 
-from . import _core
-from ._validate import _array, as_bool, as_int, as_positive_float, as_str, check_finite
-from .model.mimo import MimoModel
+from .. import _core
+from .._validate import _array, as_bool, as_int, as_positive_float, as_str, check_finite
+from ..model.mimo import MimoModel
 
 _SOLVERS = ("auto", "band", "klu", "umfpack")
 

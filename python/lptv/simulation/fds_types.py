@@ -1,12 +1,12 @@
-"""What the simulator's routes share (the SISO FDS of :mod:`lptv.fds` and the block band FDS of
-:mod:`lptv.mimo_fds`): its result type, its warnings, its solvers and limits."""
+"""What the simulator's routes share (the SISO FDS of :mod:`lptv.simulation.fds` and the block band FDS of
+:mod:`lptv.simulation.mimo_fds`): its result type, its warnings, its solvers and limits."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import _core
+from .. import _core
 
 SOLVERS = ("auto", "band", "klu", "umfpack")
 

@@ -6,14 +6,14 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from . import _core
-from ._validate import as_bool, as_int, as_positive_float, as_spectrum, as_str
+from .. import _core
+from .._validate import as_bool, as_int, as_positive_float, as_spectrum, as_str
 
-from .fds_types import (CONDITION_MAX, CONDITION_WARN, MAX_GRID_LINES, SOLVERS,  # noqa: F401 - lptv.fds.*
+from .fds_types import (CONDITION_MAX, CONDITION_WARN, MAX_GRID_LINES, SOLVERS,  # noqa: F401 - lptv.simulation.fds.*
                         ConditioningWarning, SimulationResult, TruncationWarning)
-from .model.floquet import UnstableModelWarning, unstable_warning_text
-from .model.mimo import MimoModel
-from .model.siso import Model
+from ..model.floquet import UnstableModelWarning, unstable_warning_text
+from ..model.mimo import MimoModel
+from ..model.siso import Model
 
 
 def _check_model(model, name="model"):
