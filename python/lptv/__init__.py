@@ -36,8 +36,8 @@ from .distortion import DistortionResult, LackOfFit, distortion
 from .record import RecordResult, identify_record
 from .model.floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
-from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
-from .inspection import Inspection, LineClass, inspect
+from .records.measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
+from .records.inspection import Inspection, LineClass, inspect
 from .model.siso import Model
 from .model.mimo import MimoModel
 from .excitation.mimo_multisine import MimoMultisines, mimo_multisines

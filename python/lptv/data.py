@@ -8,7 +8,7 @@ import numpy as np
 from . import _core
 from ._validate import _array, as_float, as_int, as_optional, as_periods, check_finite
 
-_periods_array = as_periods  # the name measurements.check_record imports
+_periods_array = as_periods  # the name from_periods calls it by
 
 
 def _line_vector(x, name, n, dtype):

@@ -10,7 +10,7 @@ import pytest
 
 import lptv
 from lptv.apps import cli
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 LPTV = [sys.executable, "-m", "lptv"]
 

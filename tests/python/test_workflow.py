@@ -13,7 +13,7 @@ import scipy.signal
 
 import lptv
 from lptv.apps import cli
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 FS, T0 = 100.0, 10.0
 N = int(FS * T0)

@@ -57,7 +57,7 @@ from lptv.apps import units
 from lptv.apps.report import Report, write_fit
 from lptv import METHODS
 from lptv.parameters import format_parameter_table
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 # ------------------------------------------------------------------------------ options
 

@@ -32,7 +32,7 @@ from lptv.batch.executors import LOST
 from lptv.batch.parts import CheckpointError, clear, stored_items
 from lptv.examples import (PAPER_ID_LINES, PAPER_NOISE, PAPER_SNR_IN_DB, PAPER_SNR_OUT_DB,
                            paper_model, paper_multisine)
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 
 def add_parser(sub):

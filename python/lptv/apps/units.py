@@ -18,7 +18,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 _COEF = re.compile(r"([ab])(\d+)")
 

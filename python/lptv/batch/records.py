@@ -15,7 +15,7 @@ import numpy as np
 from .._validate import as_float, as_int, as_path, as_positive_float
 from ..identify import COVARIANCES, METHODS, NOISES, _counts, _known_list, _rows, identify
 from ..atomic import atomic_open, atomic_path
-from ..measurements import Measurements, read_measurements, read_options
+from ..records.measurements import Measurements, read_measurements, read_options
 from ..model.siso import Model
 from .executors import Failure, describe_executor, require, run_tasks
 

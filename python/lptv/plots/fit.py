@@ -444,7 +444,7 @@ def inspection(insp, *, hz: bool = False, fig=None):
     >>> fig.axes[0].get_title()
     'the input repeats every 2.00 s (200 samples)'
     """
-    from ..inspection import Inspection
+    from ..records.inspection import Inspection
     from .._validate import as_bool
 
     if not isinstance(insp, Inspection):
@@ -458,7 +458,7 @@ def inspection(insp, *, hz: bool = False, fig=None):
     lag = insp.lags[1:]
     x = lag / insp.fs if insp.fs else lag
     ax.semilogy(x, np.maximum(insp.repeat[1:], 1e-12), lw=0.8, color="C0", label="input: r(L)")
-    from ..inspection import REPEAT_LIMIT
+    from ..records.inspection import REPEAT_LIMIT
 
     ax.axhline(REPEAT_LIMIT, color="C3", ls="--", lw=1, label=f"limit of a period ({REPEAT_LIMIT:g})")
     if insp.repeats:

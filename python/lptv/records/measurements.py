@@ -10,7 +10,7 @@ The channels are named with ``u=`` / ``y=`` (``--input`` / ``--output``). A long
 into periods by ``periods`` or by the sampling frequency and the period; the sampling frequency
 is given (``fs=`` / ``dt=``) or read from the file: a time column or variable (``t``, ``time``,
 ``time [s]`` ..., or ``time=``), checked uniform, or a stored scalar ``fs``, ``dt`` or ``Ts``
-(:mod:`lptv.channels`).
+(:mod:`lptv.records.channels`).
 
 Examples
 --------
@@ -32,8 +32,8 @@ from typing import Callable, Optional, Tuple
 
 import numpy as np
 
-from ._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
-from .recordcheck import RecordCheck, RecordWarning, check_record, detrended  # noqa: F401 - lptv.measurements.*
+from .._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
+from .check import RecordCheck, RecordWarning, check_record, detrended  # noqa: F401 - lptv.records.measurements.*
 from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, find, fs_from_time, listing,
                        read_several, several_channels, stored_fs, time_unit)
 
@@ -276,7 +276,7 @@ def _sampling(fs, dt):
 def samples_per_period(fs: float, period: float, what: str = "fs x period") -> int:
     """``N = fs * period`` as an integer, or :class:`FileError` when it is not one.
 
-    >>> from lptv.measurements import samples_per_period
+    >>> from lptv.records.measurements import samples_per_period
     >>> samples_per_period(100.0, 10.0)
     1000
     """

@@ -20,9 +20,9 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ._validate import _array, as_float, as_int, as_path
+from .._validate import _array, as_float, as_int, as_path
 from .channels import FileError
-from .recordscan import (ALPHA, NOISE_HALF_WINDOW, REPEAT_LIMIT, SIGMAS, WHOLE, LineClass,  # noqa: F401
+from .scan import (ALPHA, NOISE_HALF_WINDOW, REPEAT_LIMIT, SIGMAS, WHOLE, LineClass,  # noqa: F401
                          _classify, _detrended, _drift, _output_multiple, _pooled, _residue_at, _spectra,
                          _threshold, _transient, find_period, repeat_residue)
 

@@ -1,6 +1,6 @@
 """Checks of a record of periods before it is fitted: a start-up transient, a drift, periods cut
 at the wrong length (:func:`check_record`), and the drift's removal (:func:`detrended`; the
-``detrend`` option of :func:`lptv.read_measurements`). Importable from :mod:`lptv.measurements`
+``detrend`` option of :func:`lptv.read_measurements`). Importable from :mod:`lptv.records.measurements`
 as well, where they were first."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Tuple
 
 import numpy as np
 
-from ._validate import as_bool, as_float
+from .._validate import as_bool, as_float
 
 
 class RecordWarning(UserWarning):
@@ -125,7 +125,7 @@ def check_record(u, y, *, warn: bool = True, spread_limit: float = 0.1) -> Recor
     >>> "skip_periods=1" in c.messages[0]
     True
     """
-    from .data import _periods_array
+    from .._validate import as_periods as _periods_array
 
     warn = as_bool(warn, "warn")
     spread_limit = as_float(spread_limit, "spread_limit", minimum=0.0, open_min=True)

@@ -281,7 +281,7 @@ def _pooled(var, P):
     degrees of freedom of a scaled chi-square with the median's variance, 1 / (4 w f(m)^2)
     relative to m^2 (f the density at the median m)."""
     from scipy.ndimage import median_filter
-    from ._dist import gamma_median, gamma_pdf
+    from .._dist import gamma_median, gamma_pdf
 
     n = var.size
     w = min(2 * NOISE_HALF_WINDOW + 1, n)
