@@ -42,7 +42,7 @@ import numpy as np
 
 import lptv
 from lptv import _core
-from lptv.data import FrequencyData
+from lptv.spectra.frequency_data import FrequencyData
 from lptv.examples import paper_measurements
 from lptv.reference import identification as ref
 

@@ -28,11 +28,11 @@ The public API:
 """
 from ._core import NumericalError
 from .simulation.fds import ConditioningWarning, SimulationResult, TruncationWarning, band_matrices, htf, simulate
-from .data import FrequencyData
+from .spectra.frequency_data import FrequencyData
 from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
 from .uncertainty import CramerRaoBound, crb
-from .nonparametric import HtfEstimate, htf_estimate
-from .distortion import DistortionResult, LackOfFit, distortion
+from .spectra.htf_estimate import HtfEstimate, htf_estimate
+from .spectra.distortion import DistortionResult, LackOfFit, distortion
 from .record import RecordResult, identify_record
 from .model.floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
@@ -41,16 +41,16 @@ from .records.inspection import Inspection, LineClass, inspect
 from .model.siso import Model
 from .model.mimo import MimoModel
 from .excitation.mimo_multisine import MimoMultisines, mimo_multisines
-from .mimo_htf import MimoHtfEstimate, mimo_htf_estimate
-from .mimo_data import MimoFrequencyData
+from .spectra.mimo_htf_estimate import MimoHtfEstimate, mimo_htf_estimate
+from .spectra.mimo_frequency_data import MimoFrequencyData
 from .mimo_result import MimoIdentificationResult
 from .mimo_identify import MimoCramerRaoBound, mimo_crb
 from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .excitation.multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
                         multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
-from .moderation import ModeratedNoise, moderated_noise
-from .disturbances import Disturbance, DisturbanceResult, disturbances
+from .spectra.moderation import ModeratedNoise, moderated_noise
+from .spectra.disturbances import Disturbance, DisturbanceResult, disturbances
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 
 __version__ = "0.1.0"

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .data import FrequencyData
+from .spectra.frequency_data import FrequencyData
 
 
 SMOOTH = 5

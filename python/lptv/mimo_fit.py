@@ -18,7 +18,7 @@ from typing import List, Sequence
 import numpy as np
 
 from . import _core
-from .mimo_data import MimoFrequencyData, MimoStructure
+from .spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure
 
 
 class FitError(ValueError):

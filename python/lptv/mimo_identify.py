@@ -11,7 +11,7 @@ import numpy as np
 
 from ._validate import _array, as_float, as_int, as_lines, check_finite
 from .model.mimo import MimoModel
-from .mimo_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
+from .spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
 from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
 from .mimo_result import MimoIdentificationResult, residue_tests
 
@@ -23,8 +23,8 @@ AUTO_MIN_PERIODS = 4
 def _noise_route(datas, noise):
     """(route, why, the MimoModeratedNoise per experiment or None) for noise='auto', 'sample' or
     'moderated' (METHOD.md section 19, "Moderated noise for several channels")."""
-    from .moderation import smooth_noise
-    from .mimo_moderation import moderated_mimo_noise
+    from .spectra.moderation import smooth_noise
+    from .spectra.mimo_moderation import moderated_mimo_noise
 
     if noise == "sample":
         return "sample", "asked for", None

@@ -11,7 +11,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from . import _core
-from .data import FrequencyData
+from .spectra.frequency_data import FrequencyData
 from ._validate import as_positive_float
 from .model.siso import Model
 

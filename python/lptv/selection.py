@@ -11,9 +11,9 @@ import numpy as np
 
 from ._validate import as_int, as_positive_float, as_str
 from .batch.executors import describe_executor, one_blas_thread, require, run_tasks
-from .data import FrequencyData, frequency_data_of
+from .spectra.frequency_data import FrequencyData, frequency_data_of
 from .identify import IdentificationResult, _rows, identify
-from .nonparametric import HtfEstimate, htf_estimate
+from .spectra.htf_estimate import HtfEstimate, htf_estimate
 
 CRITERIA = ("mdl", "aic")
 # Columns of the ranked table, in order.

@@ -20,7 +20,7 @@ def normalized_residue(model: Model, data, lines, *, _par=None, _theta=None):
     -------
     e, var_e, r : ndarrays over the rows
     """
-    from .data import FrequencyData
+    from .spectra.frequency_data import FrequencyData
 
     if not isinstance(model, Model):
         raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")

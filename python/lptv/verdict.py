@@ -178,7 +178,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
             mo, nu_line = fitted, fitted.dof
             d = mo.unbiased_data()
         elif MODERATE and P >= 2 and res.noise == "sample":
-            from .moderation import moderated_noise, smooth_noise
+            from .spectra.moderation import moderated_noise, smooth_noise
             mo = moderated_noise(d)
             # only a smooth noise spectrum (the check of identify's noise='auto'): bumps a few
             # lines wide, smeared by the moderation, made 7-16 % of the right structures' fits

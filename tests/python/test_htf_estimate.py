@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 import lptv
-import lptv.nonparametric
+import lptv.spectra.htf_estimate
 from lptv.reference import fds as ref
 
 from conftest import random_model
@@ -93,7 +93,7 @@ def test_lines_too_close_for_the_branches_are_refused():
 
 
 def test_docstring_examples_run():
-    assert doctest.testmod(lptv.nonparametric, raise_on_error=False).failed == 0
+    assert doctest.testmod(lptv.spectra.htf_estimate, raise_on_error=False).failed == 0
 
 
 def test_plot_draws_every_branch_and_the_model():

@@ -217,7 +217,7 @@ def test_the_verdicts_moderated_variances_are_unbiased_where_the_noise_is_flat()
         d = system_measurements("discrete", seed=seed, periods=4)
         data = lptv.FrequencyData.from_periods(d["u"], d["y"], w0=d["w0"], ts=d["ts"])
         mo = lptv.moderated_noise(data)
-        if not 2 < mo.prior_dof < lptv.moderation.MAX_PRIOR_DOF:
+        if not 2 < mo.prior_dof < lptv.spectra.moderation.MAX_PRIOR_DOF:
             continue
         true = noise_variances(d["u0"], d["y0"], **d["noise"])[1] / 4
         inner = slice(1, np.asarray(data.varY).size - 1)

@@ -15,7 +15,7 @@ from typing import Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_real_1d
-from ..data import FrequencyData
+from ..spectra.frequency_data import FrequencyData
 from ..examples import noise_variances, noisy_periods
 from ..simulation.fds import simulate
 from ..identify import METHODS, identify

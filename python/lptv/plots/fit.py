@@ -131,7 +131,7 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
     """
     from ..simulation.fds import htf
     from ..model.siso import Model
-    from ..nonparametric import HtfEstimate
+    from ..spectra.htf_estimate import HtfEstimate
     from .._validate import as_bool, as_int
 
     if not isinstance(est, HtfEstimate):
@@ -383,7 +383,7 @@ def _branch_color(k: int) -> str:
 def _branches_panel(ax, res, sets, scale, n_points):
     """The model's HTF branches over the excited band and, where the record determines them, their
     nonparametric estimates (lptv.htf_estimate) with +-2 std."""
-    from ..nonparametric import htf_estimate
+    from ..spectra.htf_estimate import htf_estimate
 
     model = res.model
     K = max(model.ka, model.kb)

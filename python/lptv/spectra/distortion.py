@@ -34,9 +34,9 @@ from typing import Optional
 
 import numpy as np
 
-from . import _core
-from ._validate import as_int, as_lines, as_positive_float
-from .data import FrequencyData
+from .. import _core
+from .._validate import as_int, as_lines, as_positive_float
+from .frequency_data import FrequencyData
 
 ALPHA = 0.01
 
@@ -62,7 +62,7 @@ def _reliable_response(m, U):
     None; or None and the reason it cannot be trusted (a NumericalError, a non-finite output, a
     condition above LOF_CONDITION_MAX on some line, a truncation error above
     LOF_TRUNCATION_MAX): the solve's own figures, with its warnings silenced."""
-    from .simulation.fds import simulate
+    from ..simulation.fds import simulate
 
     try:
         with warnings.catch_warnings():
@@ -341,7 +341,7 @@ class DistortionResult:
             A first fit of the best linear approximation (e.g. of :meth:`experiments`): its
             branches refer the output level to the input.
         """
-        from .model.siso import Model
+        from ..model.siso import Model
 
         width = as_int(width, "width")
         m = getattr(model, "model", model)
@@ -452,7 +452,7 @@ class DistortionResult:
         """
         from scipy import stats
 
-        from .model.siso import Model
+        from ..model.siso import Model
 
         m = getattr(model, "model", model)
         if not isinstance(m, Model):

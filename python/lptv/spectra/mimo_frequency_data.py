@@ -8,8 +8,8 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
-from ._validate import _array, as_int, check_finite
-from .model.siso import _ts, _w0
+from .._validate import _array, as_int, check_finite
+from ..model.siso import _ts, _w0
 
 
 @dataclass(frozen=True)

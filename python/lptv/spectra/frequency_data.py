@@ -5,8 +5,8 @@ from typing import Optional
 
 import numpy as np
 
-from . import _core
-from ._validate import _array, as_float, as_int, as_optional, as_periods, check_finite
+from .. import _core
+from .._validate import _array, as_float, as_int, as_optional, as_periods, check_finite
 
 _periods_array = as_periods  # the name from_periods calls it by
 

@@ -9,9 +9,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
-from ._validate import as_int
-from .mimo_data import MimoFrequencyData
+from .. import _core
+from .._validate import as_int
+from .mimo_frequency_data import MimoFrequencyData
 
 
 @dataclass(frozen=True)
@@ -90,7 +90,7 @@ def moderated_mimo_noise(data: MimoFrequencyData, half_width: int = 10) -> MimoM
         outliers = np.asarray(r.outliers, int).reshape(-1)
         own_weight, neighbour = np.asarray(r.own_weight, float), np.asarray(r.neighbour, bool)
     else:
-        from .reference.moderation import moderated_covariances
+        from ..reference.moderation import moderated_covariances
 
         r = moderated_covariances(data.C, int(data.periods), int(data.n_outputs), W)
         C, dof, d0, outliers, own_weight, neighbour = r.C, r.dof, r.prior_dof, r.outliers, r.own_weight, r.neighbour

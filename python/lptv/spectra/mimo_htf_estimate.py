@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validate import _array, as_int, as_lines, check_finite
+from .._validate import _array, as_int, as_lines, check_finite
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from typing import Tuple
 
 import numpy as np
 
-from ._validate import as_float, as_int, as_periods
+from .._validate import as_float, as_int, as_periods
 
 ALPHA = 1e-3
 """Probability that noise alone puts one bin of a record above the detection threshold."""

@@ -6,9 +6,9 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from . import _core
-from ._validate import as_float, as_lines, as_int, as_str
-from .data import FrequencyData, frequency_data_of
+from .. import _core
+from .._validate import as_float, as_lines, as_int, as_str
+from .frequency_data import FrequencyData, frequency_data_of
 
 
 def _lpm_data(u, y, w0, ts, degree, width):
@@ -172,7 +172,7 @@ def htf_estimate(u, y=None, *, w0: Optional[float] = None, ts: Optional[float] =
     >>> est.significant().tolist()        # the modulation reaches one line each side
     [-1, 0, 1]
     """
-    from ._dist import gamma_sf
+    from .._dist import gamma_sf
 
     method = as_str(method, "method", ("ratio", "lpm"))
     dof = None

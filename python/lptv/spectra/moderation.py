@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
-from ._validate import as_int
+from .. import _core
+from .._validate import as_int
 
 OUTLIER_RATE = _core.MODERATION_OUTLIER_RATE
 """A line whose sample variance exceeds its neighbours' by more than noise alone does with this
@@ -78,7 +78,7 @@ class ModeratedNoise:
         >>> mo.unbiased_data().varY.shape == mo.data.varY.shape
         True
         """
-        from .data import FrequencyData
+        from .frequency_data import FrequencyData
 
         m, d0 = self.data, self.prior_dof
         if not d0 > 2 or self.own_weight is None or self.source_covYU is None:
@@ -102,7 +102,7 @@ class ModeratedNoise:
         not in it."""
         lines = np.asarray(lines, int)
         if self._core is None:      # built by hand, not by moderated_noise
-            from .reference.moderation import ModeratedNoise as _Reference
+            from ..reference.moderation import ModeratedNoise as _Reference
 
             return _Reference.error_covariance(self, lines)
         if lines.ndim != 1:
@@ -153,8 +153,8 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     >>> round(mod.prior_dof), round(float(np.median(mod.dof)))
     (43, 37)
     """
-    from .data import FrequencyData
-    from .mimo_data import MimoFrequencyData
+    from .frequency_data import FrequencyData
+    from .mimo_frequency_data import MimoFrequencyData
 
     if isinstance(data, MimoFrequencyData):
         from .mimo_moderation import moderated_mimo_noise
@@ -269,7 +269,7 @@ def smooth_noise(mo: ModeratedNoise):
     Examples
     --------
     >>> import numpy as np, lptv
-    >>> from lptv.moderation import smooth_noise
+    >>> from lptv.spectra.moderation import smooth_noise
     >>> rng = np.random.default_rng(0)
     >>> u = rng.standard_normal((4, 512)); y = rng.standard_normal((4, 512))
     >>> ok, why = smooth_noise(lptv.moderated_noise(lptv.FrequencyData.from_periods(u, y, w0=1.0)))
