@@ -29,11 +29,11 @@ The public API:
 from ._core import NumericalError
 from .simulation.fds import ConditioningWarning, SimulationResult, TruncationWarning, band_matrices, htf, simulate
 from .spectra.frequency_data import FrequencyData
-from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
-from .uncertainty import CramerRaoBound, crb
+from .estimation.identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
+from .estimation.crb import CramerRaoBound, crb
 from .spectra.htf_estimate import HtfEstimate, htf_estimate
 from .spectra.distortion import DistortionResult, LackOfFit, distortion
-from .record import RecordResult, identify_record
+from .estimation.one_record import RecordResult, identify_record
 from .model.floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
 from .selection import SelectionResult, select
 from .records.measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
@@ -44,7 +44,7 @@ from .excitation.mimo_multisine import MimoMultisines, mimo_multisines
 from .spectra.mimo_htf_estimate import MimoHtfEstimate, mimo_htf_estimate
 from .spectra.mimo_frequency_data import MimoFrequencyData
 from .mimo_result import MimoIdentificationResult
-from .mimo_identify import MimoCramerRaoBound, mimo_crb
+from .estimation.mimo_identify import MimoCramerRaoBound, mimo_crb
 from .parameters import compare, freqresp_band, lti_table, parameter_table
 from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .excitation.multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,

@@ -134,7 +134,7 @@ def small_fit():
     (1, 2, ('a0[0,0].re0', 'a0[0,1].re0'))
     """
     from .simulation.fds import simulate
-    from .identify import identify
+    from .estimation.identify import identify
     from .excitation.multisine import multisine
 
     a = np.zeros((2, 2, 2))

@@ -502,7 +502,7 @@ def excited_rows(data: FrequencyData, K: int = 0, ratio: float = 100.0) -> np.nd
     Examples
     --------
     >>> import numpy as np, lptv
-    >>> from lptv.identify import excited_rows
+    >>> from lptv.estimation.identify import excited_rows
     >>> ms = lptv.multisine([3, 5], 64, seed=0)
     >>> rng = np.random.default_rng(0)
     >>> u = ms.periods(4) + 1e-3 * rng.standard_normal((4, 64))

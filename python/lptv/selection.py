@@ -12,7 +12,7 @@ import numpy as np
 from ._validate import as_int, as_positive_float, as_str
 from .batch.executors import describe_executor, one_blas_thread, require, run_tasks
 from .spectra.frequency_data import FrequencyData, frequency_data_of
-from .identify import IdentificationResult, _rows, identify
+from .estimation.identify import IdentificationResult, _rows, identify
 from .spectra.htf_estimate import HtfEstimate, htf_estimate
 
 CRITERIA = ("mdl", "aic")

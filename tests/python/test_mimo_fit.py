@@ -93,7 +93,7 @@ def test_sml_and_covariances_match_reference(system, seed):
     cov_ref = np.linalg.inv(ref.fisher(st, res.eta, data))
     cov = res.covariance[np.ix_(free, free)] / res.covariance_factor
     assert np.allclose(cov, cov_ref, rtol=1e-8, atol=1e-10 * np.abs(cov_ref).max())
-    from lptv.mimo_fit import core_data, core_structure, sandwich
+    from lptv.estimation.mimo_fit import core_data, core_structure, sandwich
     from lptv.spectra.mimo_frequency_data import MimoStructure
     datas = [MimoFrequencyData.from_periods(u, y, w0=mx.W0) for u, y in pairs]
     ny, nu = model.n_outputs, model.n_inputs
@@ -235,9 +235,9 @@ def test_docstring_examples_run():
     import doctest
     import lptv.spectra.mimo_frequency_data
     import lptv.mimo_examples
-    import lptv.mimo_identify
+    import lptv.estimation.mimo_identify
     import lptv.mimo_result
-    for mod in (lptv.spectra.mimo_frequency_data, lptv.mimo_examples, lptv.mimo_identify, lptv.mimo_result):
+    for mod in (lptv.spectra.mimo_frequency_data, lptv.mimo_examples, lptv.estimation.mimo_identify, lptv.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
     # lptv.identify's own examples, the MIMO one included

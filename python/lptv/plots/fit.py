@@ -216,7 +216,7 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
     >>> [ax.get_ylabel() for ax in fig.axes]
     ['|Y/U| (dB)', 'phase of Y/U (deg)', '|G_k| (dB)']
     """
-    from ..identify import IdentificationResult, excited_rows
+    from ..estimation.identify import IdentificationResult, excited_rows
     from .._validate import as_bool, as_float, as_int
 
     if not isinstance(res, IdentificationResult):

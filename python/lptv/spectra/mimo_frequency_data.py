@@ -1,6 +1,6 @@
 """The data of a fit with several inputs and outputs (METHOD.md section 19, eq. 19.10): the
 periods' mean spectra of all channels and the (co)variances of those means, and the structure
-(orders and harmonic counts of each entry) the estimators of :mod:`lptv.mimo_fit` read."""
+(orders and harmonic counts of each entry) the estimators of :mod:`lptv.estimation.mimo_fit` read."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -6,13 +6,13 @@ from typing import Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _core
-from ._validate import _array, as_int, as_spectrum
-from .simulation.fds import simulate
+from .. import _core
+from .._validate import _array, as_int, as_spectrum
+from ..simulation.fds import simulate
 from .identify import _counts, _known_list, _rows
-from .model.mimo import MimoModel
-from .model.siso import Model
-from .excitation.multisine import Multisine
+from ..model.mimo import MimoModel
+from ..model.siso import Model
+from ..excitation.multisine import Multisine
 
 
 @dataclass(frozen=True)

@@ -7,13 +7,13 @@ from typing import Mapping, Optional, Sequence, Union
 
 import numpy as np
 
-from . import _core
-from .spectra.frequency_data import FrequencyData, experiments_of, frequency_data_of
-from .model.floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
-from .model.siso import Model
-from ._validate import INT_MAX, as_counts, as_float, as_int, as_lines
+from .. import _core
+from ..spectra.frequency_data import FrequencyData, experiments_of, frequency_data_of
+from ..model.floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
+from ..model.siso import Model
+from .._validate import INT_MAX, as_counts, as_float, as_int, as_lines
 from .mimo_identify import identify_mimo, is_mimo
-from .result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
+from ..result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 NOISES = ("auto", "sample", "moderated")
@@ -359,7 +359,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
 def _without_disturbances(u, y, several):
     """disturbances='remove': the periods without the sinusoids :func:`lptv.disturbances` finds
     (each (u, y) pair of several experiments alike), and those sinusoids."""
-    from .spectra.disturbances import disturbances as find
+    from ..spectra.disturbances import disturbances as find
 
     def clean(uu, yy, where):
         if isinstance(uu, FrequencyData):
@@ -389,7 +389,7 @@ def _without_disturbances(u, y, several):
 def _auto_noise(datas, covariance):
     """noise='auto': ('moderated' or 'sample', the sentence saying why, the moderated data and
     their ModeratedNoise per experiment for 'moderated', else None)."""
-    from .spectra.moderation import moderated_noise, smooth_noise
+    from ..spectra.moderation import moderated_noise, smooth_noise
 
     if covariance in ("bootstrap", "realisations"):
         return "sample", f"the sample variances: covariance='{covariance}' resamples them", None
@@ -417,7 +417,7 @@ def _moderated(d, mo=None):
     unchanged and None when they cannot be moderated (statistics not from periods, too few
     lines). The periods the moderated variances are worth: 1 + nu / 2, nu the median of the
     lines' degrees of freedom (the covariance's small-sample factor takes one P per data set)."""
-    from .spectra.moderation import moderated_noise
+    from ..spectra.moderation import moderated_noise
 
     if d.periods < 2:
         return d, None
@@ -490,7 +490,7 @@ def realisation_covariance(estimates, dof=None, ratio=None) -> np.ndarray:
     n = est.shape[1]
     s = np.ones(n)
     if dof is not None:
-        from ._dist import t_ppf
+        from .._dist import t_ppf
 
         nu = np.asarray(dof, dtype=float)
         if nu.shape != (n,) or not np.all(np.isfinite(nu)) or np.any(nu < 1) or np.any(nu > E - 1):

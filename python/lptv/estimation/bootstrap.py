@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .spectra.frequency_data import FrequencyData
+from ..spectra.frequency_data import FrequencyData
 
 
 SMOOTH = 5
@@ -67,7 +67,7 @@ def bootstrap_covariance(res, data: FrequencyData, fit, B: int, seed) -> np.ndar
     """Covariance of ``res.eta`` from B parametric bootstrap refits; ``fit(FrequencyData)`` returns
     an estimate's eta (the same method, structure and rows). Failed refits are skipped; fewer
     than B / 2 successes raise ValueError."""
-    from .simulation.fds import simulate
+    from ..simulation.fds import simulate
 
     rng = np.random.default_rng(seed)
     U0 = np.asarray(data.U)

@@ -17,8 +17,8 @@ from typing import List, Sequence
 
 import numpy as np
 
-from . import _core
-from .spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure
+from .. import _core
+from ..spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure
 
 
 class FitError(ValueError):

@@ -1,5 +1,5 @@
 """lptv.identify for several inputs and outputs (METHOD.md section 19): the arguments, the rows,
-the estimators of :mod:`lptv.mimo_fit`, the covariance with its small-sample factor, the
+the estimators of :mod:`lptv.estimation.mimo_fit`, the covariance with its small-sample factor, the
 verdict; and :func:`mimo_crb`, the Cramer-Rao bound of a MIMO design."""
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from ._validate import _array, as_float, as_int, as_lines, check_finite
-from .model.mimo import MimoModel
-from .spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
+from .._validate import _array, as_float, as_int, as_lines, check_finite
+from ..model.mimo import MimoModel
+from ..spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
 from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
-from .mimo_result import MimoIdentificationResult, residue_tests
+from ..mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
 AUTO_MIN_PERIODS = 4
@@ -23,8 +23,8 @@ AUTO_MIN_PERIODS = 4
 def _noise_route(datas, noise):
     """(route, why, the MimoModeratedNoise per experiment or None) for noise='auto', 'sample' or
     'moderated' (METHOD.md section 19, "Moderated noise for several channels")."""
-    from .spectra.moderation import smooth_noise
-    from .spectra.mimo_moderation import moderated_mimo_noise
+    from ..spectra.moderation import smooth_noise
+    from ..spectra.mimo_moderation import moderated_mimo_noise
 
     if noise == "sample":
         return "sample", "asked for", None
@@ -328,7 +328,7 @@ def mimo_crb(model: MimoModel, inputs, *, noise, periods: int, lines=None, ka=No
     check_finite(C, "noise")
     if np.any(np.real(np.diagonal(C, axis1=1, axis2=2)) < 0):
         raise ValueError("noise must hold non-negative variances, got a negative one")
-    from .simulation.fds import simulate
+    from ..simulation.fds import simulate
 
     ka = model.a.shape[3] // 2 if ka is None else ka
     kb = model.b.shape[3] // 2 if kb is None else kb
