@@ -43,10 +43,10 @@ from .model.mimo import MimoModel
 from .excitation.mimo_multisine import MimoMultisines, mimo_multisines
 from .spectra.mimo_htf_estimate import MimoHtfEstimate, mimo_htf_estimate
 from .spectra.mimo_frequency_data import MimoFrequencyData
-from .mimo_result import MimoIdentificationResult
+from .judgement.mimo_result import MimoIdentificationResult
 from .estimation.mimo_identify import MimoCramerRaoBound, mimo_crb
-from .parameters import compare, freqresp_band, lti_table, parameter_table
-from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
+from .judgement.parameters import compare, freqresp_band, lti_table, parameter_table
+from .judgement.validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
 from .excitation.multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
                         multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
 from .spectra.moderation import ModeratedNoise, moderated_noise

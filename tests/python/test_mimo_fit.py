@@ -236,8 +236,8 @@ def test_docstring_examples_run():
     import lptv.spectra.mimo_frequency_data
     import lptv.mimo_examples
     import lptv.estimation.mimo_identify
-    import lptv.mimo_result
-    for mod in (lptv.spectra.mimo_frequency_data, lptv.mimo_examples, lptv.estimation.mimo_identify, lptv.mimo_result):
+    import lptv.judgement.mimo_result
+    for mod in (lptv.spectra.mimo_frequency_data, lptv.mimo_examples, lptv.estimation.mimo_identify, lptv.judgement.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
     # lptv.identify's own examples, the MIMO one included

@@ -1,4 +1,4 @@
-"""The verdict's residue tests (lptv.verdict, METHOD.md section 7) and the bounded stability
+"""The verdict's residue tests (lptv.judgement.verdict, METHOD.md section 7) and the bounded stability
 check (METHOD.md section 15). Size and power over many realisations: bench/python/bench_verdict.py."""
 import subprocess
 import sys
@@ -90,9 +90,9 @@ def test_leverage_sums_to_half_the_parameters_for_an_lti_model(monkeypatch):
     computation through S_r = (I - Pi) S (I - Pi)^T must reproduce). It needs W = diag(S)^-1,
     so S from the same (sample) variances as the fit's weights: the moderated variances are
     switched off here (with them S and W differ by design, METHOD.md section 7)."""
-    import lptv.verdict
+    import lptv.judgement.verdict
 
-    monkeypatch.setattr(lptv.verdict, "MODERATE", False)
+    monkeypatch.setattr(lptv.judgement.verdict, "MODERATE", False)
     m = lptv.Model([[2.0], [1.0], [0.5]], [[1.0], [0.3]], w0=0.1)
     ms = lptv.multisine(range(1, 60), 256, seed=0)
     y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)

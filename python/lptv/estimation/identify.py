@@ -13,7 +13,7 @@ from ..model.floquet import StabilityUndecidedWarning, UnstableModelWarning, sta
 from ..model.siso import Model
 from .._validate import INT_MAX, as_counts, as_float, as_int, as_lines
 from .mimo_identify import identify_mimo, is_mimo
-from ..result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
+from ..judgement.result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
 NOISES = ("auto", "sample", "moderated")

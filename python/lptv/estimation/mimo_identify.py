@@ -13,7 +13,7 @@ from .._validate import _array, as_float, as_int, as_lines, check_finite
 from ..model.mimo import MimoModel
 from ..spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
 from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
-from ..mimo_result import MimoIdentificationResult, residue_tests
+from ..judgement.mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
 AUTO_MIN_PERIODS = 4

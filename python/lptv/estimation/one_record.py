@@ -21,8 +21,8 @@ import numpy as np
 from .. import _core
 from .._validate import as_counts, as_int, as_positive_float, as_real_1d, as_seed
 from ..model.siso import Model
-from ..record_score import harmonic_score_tests
-from ..record_verdict import RecordVerdict, record_verdict
+from ..judgement.one_record_score import harmonic_score_tests
+from ..judgement.one_record_verdict import RecordVerdict, record_verdict
 
 
 @dataclass(frozen=True)

@@ -256,7 +256,7 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
     shown = []
     curve = None
     if lti:
-        from ..parameters import freqresp_band
+        from ..judgement.parameters import freqresp_band
 
         w_all = np.concatenate([s[2] for s in sets]) * model.w0
         wmax = np.pi / model.ts if model.discrete else w_all.max() * 1.5
@@ -351,7 +351,7 @@ def _predicted_ratio(res, d, rows):
     (central differences of the simulated output over the parameters, first order); the stds are
     None without a covariance."""
     from ..simulation.fds import simulate
-    from ..parameters import perturbed_model
+    from ..judgement.parameters import perturbed_model
 
     model = res.model
     U = d.U[rows]

@@ -61,7 +61,7 @@ def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA, scores=())
     normalised residual on ``lines`` and the model's largest harmonic count ``kmax``;
     ``scores``: the score tests of :func:`lptv.record_score.harmonic_score_tests`, combined with
     the windowed test's pooled p-value by Holm's method at ``alpha``."""
-    from ._dist import f_sf
+    from .._dist import f_sf
 
     N = U.size
     lines = np.asarray(lines)

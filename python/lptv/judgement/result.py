@@ -10,10 +10,10 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from . import _core
-from .spectra.frequency_data import FrequencyData
-from ._validate import as_positive_float
-from .model.siso import Model
+from .. import _core
+from ..spectra.frequency_data import FrequencyData
+from .._validate import as_positive_float
+from ..model.siso import Model
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -146,7 +146,7 @@ class IdentificationResult:
         >>> bool(lo < 2.0 < hi)
         True
         """
-        from ._dist import norm_ppf
+        from .._dist import norm_ppf
 
         level = as_positive_float(level, "level")
         if not 0.0 < level < 1.0:
@@ -267,7 +267,7 @@ class IdentificationResult:
         datas = self.experiments or ((self.data,) if self.data is not None else ())
         if not datas:
             return None
-        from .simulation.fds import simulate
+        from ..simulation.fds import simulate
 
         experiment = self.experiment if self.experiments else np.zeros(self.lines.size, int)
         err, noise = [], []

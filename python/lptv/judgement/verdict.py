@@ -28,7 +28,7 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import _core
+from .. import _core
 
 ALPHA = 0.01
 """Overall size of the residue tests (Holm's combination)."""
@@ -114,7 +114,7 @@ class ResidueTests:
 
 def _signal_lines(d, P: int) -> np.ndarray:
     """Lines 0..max_line where the output or the input stands above its noise."""
-    from . import _dist as stats_
+    from .. import _dist as stats_
 
     if P >= 2:
         nu = 2 * (P - 1)
@@ -141,7 +141,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     """The verdict's tests of an identification result, or None when they cannot be formed
     (no data kept, no noise, no rows). ``structure`` is the core's Structure of the fit;
     ``excited`` the excited lines of each experiment (default: ``lptv.excited_lines``)."""
-    from . import _dist as stats_
+    from .. import _dist as stats_
     from scipy.linalg import block_diag
 
     datas = list(res.experiments) if res.experiments else ([res.data] if res.data is not None else [])
@@ -178,7 +178,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
             mo, nu_line = fitted, fitted.dof
             d = mo.unbiased_data()
         elif MODERATE and P >= 2 and res.noise == "sample":
-            from .spectra.moderation import moderated_noise, smooth_noise
+            from ..spectra.moderation import moderated_noise, smooth_noise
             mo = moderated_noise(d)
             # only a smooth noise spectrum (the check of identify's noise='auto'): bumps a few
             # lines wide, smeared by the moderation, made 7-16 % of the right structures' fits
@@ -384,7 +384,7 @@ def _score_test(parts, par_x, name):
     2 F(2, nu_eff) with nu_eff the rows' Satterthwaite degrees of freedom. Returns (F value,
     p-value), or None (a row with fewer than 6 degrees of freedom: 2 or 3 periods; nothing to
     test)."""
-    from . import _dist as stats_
+    from .. import _dist as stats_
 
     if not parts:
         return None
@@ -441,7 +441,7 @@ def propagated_input_noise(model, d, rows: np.ndarray) -> np.ndarray:
     gives the model's output Y_model = G U (G = A^-1 B, the model's HTF), lines taken as
     independent. Continuous time: the input lines from -W to max(rows) + W with W = 2K + 16
     (the HTF decays away from its diagonal), on a grid with 64 guard lines beyond them."""
-    from .simulation.fds import htf
+    from ..simulation.fds import htf
 
     varU = np.asarray(d.varU)
     rows = np.asarray(rows, int)
@@ -466,8 +466,8 @@ def prediction_variance(res, d, rows: np.ndarray, Yp: np.ndarray) -> np.ndarray:
     """g_l^H Cov(eta) g_l on ``rows``, g_l = dY_model,l / d eta by forward differences of the
     simulated output (the model is linear in its coefficients; a relative step of 1e-7 leaves
     an error of that order in g); zero without a covariance."""
-    from .simulation.fds import simulate
-    from .model.siso import Model
+    from ..simulation.fds import simulate
+    from ..model.siso import Model
 
     cov = res.covariance
     if cov is None or res.structure is None:

@@ -21,7 +21,7 @@ def _source(obj):
     """(model, eta names, eta values, covariance or None) of a result or a model. A result is
     anything with a model, eta_names, eta and covariance (lptv.identify's, identify_record's):
     read by its attributes, so that this module imports no result type (which imports it)."""
-    from .model.siso import Model
+    from ..model.siso import Model
 
     if not isinstance(obj, Model) and all(hasattr(obj, a) for a in ("model", "eta_names", "eta", "covariance")) \
             and isinstance(obj.model, Model):
@@ -48,8 +48,8 @@ def _parse(name):
 
 
 def _z(level):
-    from ._dist import norm_ppf
-    from ._validate import as_float
+    from .._dist import norm_ppf
+    from .._validate import as_float
 
     level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
     return float(norm_ppf(0.5 + level / 2.0))
@@ -252,7 +252,7 @@ def format_parameter_table(obj, level: float = 0.95) -> str:
 
 def perturbed_model(model, name: str, delta: float):
     """A copy of ``model`` with the real parameter ``name`` (e.g. 'a0.re1') moved by ``delta``."""
-    from .model.siso import Model
+    from ..model.siso import Model
 
     side, n, part, k = _parse(name)
     a, b = model.a.copy(), model.b.copy()
@@ -315,10 +315,10 @@ def compare(obj, u, y):
     >>> round(lptv.compare(m, u, y)["fit"], 9)
     100.0
     """
-    from .simulation.fds import simulate
-    from .excitation.multisine import spectrum, time_signal
+    from ..simulation.fds import simulate
+    from ..excitation.multisine import spectrum, time_signal
 
-    from ._validate import _array, check_finite
+    from .._validate import _array, check_finite
 
     model = _source(obj)[0]
     sig = {}

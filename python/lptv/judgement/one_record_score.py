@@ -12,7 +12,7 @@ from typing import List, Tuple
 
 import numpy as np
 
-from . import _core
+from .. import _core
 
 STEP = 1e-6
 """Relative step of the central differences."""
@@ -45,7 +45,7 @@ def harmonic_score_tests(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta,
 
     ``eta``: the fit's real parameters (all, as ``fit.eta``), ``c`` its transient coefficients,
     ``residual`` Y - Y_hat on ``lines``, ``var`` the noise variance per line the cost divides by."""
-    from ._dist import f_sf
+    from .._dist import f_sf
 
     lines = np.asarray(lines)
     N = U.size

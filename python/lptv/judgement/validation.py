@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _core
-from ._validate import as_int, as_lines, as_real_1d
-from .model.mimo import MimoModel
-from .model.siso import Model
+from .. import _core
+from .._validate import as_int, as_lines, as_real_1d
+from ..model.mimo import MimoModel
+from ..model.siso import Model
 
 
 def _structure_of(model: Model):
@@ -20,7 +20,7 @@ def normalized_residue(model: Model, data, lines, *, _par=None, _theta=None):
     -------
     e, var_e, r : ndarrays over the rows
     """
-    from .spectra.frequency_data import FrequencyData
+    from ..spectra.frequency_data import FrequencyData
 
     if not isinstance(model, Model):
         raise ValueError(f"model must be an lptv.Model, got {type(model).__name__}")

@@ -9,8 +9,8 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ._validate import as_positive_float
-from .model.mimo import MimoModel
+from .._validate import as_positive_float
+from ..model.mimo import MimoModel
 
 ALPHA = 0.01
 """Overall size of the residue tests (Holm's combination), as for one input and output."""
@@ -90,7 +90,7 @@ class MimoIdentificationResult:
         >>> res.confidence_interval(0.95).shape == (res.eta.size, 2)
         True
         """
-        from ._dist import norm_ppf
+        from .._dist import norm_ppf
 
         level = as_positive_float(level, "level")
         if not 0.0 < level < 1.0:
@@ -150,7 +150,7 @@ class MimoIdentificationResult:
 def residue_tests(residue, covariance, periods) -> Tuple:
     """Eq. 19.14 per row: each output's |e_p|^2 / C_pp ~ F(2, 2(P-1)) and the joint
     (P-ny)/(ny(P-1)) e^H C^-1 e ~ F(2 ny, 2(P-ny)) (for P > ny); ``periods`` per row."""
-    from ._dist import f_sf
+    from .._dist import f_sf
 
     R, ny = residue.shape
     P = np.asarray(periods, dtype=float)
