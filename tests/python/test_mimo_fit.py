@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import lptv
-from lptv import mimo_examples as mx
+from lptv.examples import mimo as mx
 from lptv.spectra.mimo_frequency_data import MimoFrequencyData
 from lptv.reference import mimo_fit as ref
 
@@ -234,10 +234,10 @@ def test_bad_inputs_name_the_argument(call, word):
 def test_docstring_examples_run():
     import doctest
     import lptv.spectra.mimo_frequency_data
-    import lptv.mimo_examples
+    import lptv.examples.mimo
     import lptv.estimation.mimo_identify
     import lptv.judgement.mimo_result
-    for mod in (lptv.spectra.mimo_frequency_data, lptv.mimo_examples, lptv.estimation.mimo_identify, lptv.judgement.mimo_result):
+    for mod in (lptv.spectra.mimo_frequency_data, lptv.examples.mimo, lptv.estimation.mimo_identify, lptv.judgement.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
     # lptv.identify's own examples, the MIMO one included

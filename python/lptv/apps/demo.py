@@ -24,7 +24,7 @@ import numpy as np
 
 from lptv import crb, floquet, frozen_poles, frozen_zeros, identify, plots, simulate
 from lptv.apps.report import Report, write_json
-from lptv.examples import (mathieu_model, noise_variances, PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, PAPER_NOISE, PAPER_SNR_IN_DB,
+from lptv.examples.siso import (mathieu_model, noise_variances, PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, PAPER_NOISE, PAPER_SNR_IN_DB,
                            PAPER_SNR_OUT_DB, noisy_periods, paper_measurements)
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_real_1d
 from ..spectra.frequency_data import FrequencyData
-from ..examples import noise_variances, noisy_periods
+from ..examples.siso import noise_variances, noisy_periods
 from ..simulation.fds import simulate
 from ..estimation.identify import METHODS, identify
 from ..model.siso import Model

@@ -85,7 +85,7 @@ class MimoIdentificationResult:
         Examples
         --------
         >>> import numpy as np, lptv
-        >>> from lptv.mimo_examples import small_fit
+        >>> from lptv.examples.mimo import small_fit
         >>> res = small_fit()
         >>> res.confidence_interval(0.95).shape == (res.eta.size, 2)
         True

@@ -16,7 +16,7 @@ from typing import Callable, Dict, Tuple
 
 import numpy as np
 
-from .model.mimo import MimoModel
+from ..model.mimo import MimoModel
 
 W0 = 1.0
 RTOL, ATOL = 1e-12, 1e-14
@@ -128,14 +128,14 @@ def small_fit():
 
     Examples
     --------
-    >>> from lptv.mimo_examples import small_fit
+    >>> from lptv.examples.mimo import small_fit
     >>> res = small_fit()
     >>> res.model.n_inputs, res.model.n_outputs, res.parameter_names[:2]
     (1, 2, ('a0[0,0].re0', 'a0[0,1].re0'))
     """
-    from .simulation.fds import simulate
-    from .estimation.identify import identify
-    from .excitation.multisine import multisine
+    from ..simulation.fds import simulate
+    from ..estimation.identify import identify
+    from ..excitation.multisine import multisine
 
     a = np.zeros((2, 2, 2))
     a[1] = np.eye(2)

@@ -1,32 +1,13 @@
-"""Models and excitations the documentation, tests, benchmarks and demo share.
-
-The paper's simulation example (METHOD.md section 8) does not give its harmonic
-amplitudes, w0 or number of periods; the choices below are ours, stated here:
-
-- mean (DC) system (s + 1) / (s^2 + s + 1), i.e. a = (1, 1, 1), b = (1, 1);
-- 3 harmonics on each of a0, a1, a2, b0, b1 with the amplitudes in ``PAPER_HARMONICS``
-  (3 to 19 % of the DC values, falling with k; a_2(t) >= 0.82 > 0, a_0(t) >= 0.48 and every
-  frozen system is stable). Harmonics of only a few % were tried first: then a common
-  periodic factor of numerator and denominator, truncated to 3 harmonics, changes the residue
-  by less than the noise (the two smallest generalised singular values of WGTLS were 1.0 and
-  1.9 instead of 1.0 and 5), and the harmonics are poorly determined at 50/30 dB SNR;
-- w0 = 0.04 rad/s (T0 = 157 s), so the excited lines 10, 20, ..., 240 span 0.4 .. 9.6 rad/s
-  around the resonance at 1 rad/s (line 25);
-- the multisine has 24 lines of equal amplitude sqrt(2/24) (rms 1, whatever the number of
-  lines) and N = 2048 samples per period;
-- the measurement noise (``paper_measurements``): 50 dB mean SNR on the input, 30 dB on the
-  output, first-order low-pass noise with poles 0.6 (input) and 0.8 (output), the output noise
-  sharing half of its driving sequence with the input noise (``PAPER_NOISE``);
-  ``noise_variances`` gives the true per-line (co)variances of that noise, for :func:`lptv.crb`.
-"""
+"""The one-channel systems and data of :mod:`lptv.examples`, which re-exports them; its docstring
+states the choices of the paper's example."""
 from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_int
-from .simulation.fds import simulate
-from .model.siso import Model
-from .excitation.multisine import multisine, time_signal
+from .._validate import as_int
+from ..simulation.fds import simulate
+from ..model.siso import Model
+from ..excitation.multisine import multisine, time_signal
 
 PAPER_W0 = 0.04
 PAPER_N = 2048
@@ -538,7 +519,7 @@ def continuous_record(model: Model, periods: int = 2, samples_per_period: int = 
     >>> u.shape, round(ts, 4)
     ((2624,), 0.0958)
     """
-    from .simulation import timedomain
+    from ..simulation import timedomain
 
     if not isinstance(model, Model) or model.discrete:
         raise ValueError("model must be a continuous-time lptv.Model")
