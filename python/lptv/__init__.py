@@ -35,7 +35,7 @@ from .spectra.htf_estimate import HtfEstimate, htf_estimate
 from .spectra.distortion import DistortionResult, LackOfFit, distortion
 from .estimation.one_record import RecordResult, identify_record
 from .model.floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
-from .selection import SelectionResult, select
+from .batch.selection import SelectionResult, select
 from .records.measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
 from .records.inspection import Inspection, LineClass, inspect
 from .model.siso import Model

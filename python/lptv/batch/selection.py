@@ -9,11 +9,11 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ._validate import as_int, as_positive_float, as_str
-from .batch.executors import describe_executor, one_blas_thread, require, run_tasks
-from .spectra.frequency_data import FrequencyData, frequency_data_of
-from .estimation.identify import IdentificationResult, _rows, identify
-from .spectra.htf_estimate import HtfEstimate, htf_estimate
+from .._validate import as_int, as_positive_float, as_str
+from .executors import describe_executor, one_blas_thread, require, run_tasks
+from ..spectra.frequency_data import FrequencyData, frequency_data_of
+from ..estimation.identify import IdentificationResult, _rows, identify
+from ..spectra.htf_estimate import HtfEstimate, htf_estimate
 
 CRITERIA = ("mdl", "aic")
 # Columns of the ranked table, in order.
