@@ -1,6 +1,6 @@
 """What :func:`lptv.identify` returns: :class:`IdentificationResult` (the estimate, its
 covariance, the residues and the verdict read from them), and the rows the verdict judges
-(:func:`excited_rows`). Importable from :mod:`lptv.identify` as well, where they were first."""
+(:func:`excited_rows`). Importable from :mod:`lptv.estimation.identify` as well, where they were first."""
 from __future__ import annotations
 
 import warnings

@@ -153,7 +153,7 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     >>> lptv.read_measurements(path, fs=100.0, period=1.0)
     Traceback (most recent call last):
     ...
-    lptv.channels.FileError: variable 'u' has 1050 samples, 10.5 periods of 100 (fs 100 Hz x period 1 s): drop 50 samples to keep 10 whole periods (or trim=True / --trim)
+    lptv.records.channels.FileError: variable 'u' has 1050 samples, 10.5 periods of 100 (fs 100 Hz x period 1 s): drop 50 samples to keep 10 whole periods (or trim=True / --trim)
     >>> m = lptv.read_measurements(path, fs=100.0, period=1.0, trim=True, skip_periods=1)
     >>> m.u.shape, m.trimmed, m.skipped
     ((9, 100), 50, 1)
