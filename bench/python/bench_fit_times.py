@@ -19,7 +19,7 @@ import time
 
 import lptv
 from lptv import _core
-from lptv.data import FrequencyData
+from lptv.spectra.frequency_data import FrequencyData
 from lptv.examples import paper_measurements
 
 ROUNDS, CALLS, TOL = 7, 40, 1e-12

@@ -4,7 +4,7 @@
 
 - ``lptv.floquet(paper_model())``: Hill's method in the core (harmonics of F(t) from 1/a_2(t),
   the truncation grown until the exponents settle), as a user calls it;
-- ``monodromy + eig``: ``lptv.floquet.monodromy`` (the product of 2 x 2000 fourth-order Magnus
+- ``monodromy + eig``: ``lptv.model.floquet.monodromy`` (the product of 2 x 2000 fourth-order Magnus
   exponentials and a Richardson step) and ``numpy.linalg.eigvals``;
 - the same two on the damped Mathieu example (``lptv.examples.mathieu_model()``, unstable).
 
@@ -20,7 +20,7 @@ import numpy as np
 
 import lptv
 from lptv.examples import mathieu_model, paper_model
-from lptv.floquet import monodromy
+from lptv.model.floquet import monodromy
 
 AGREE = 1e-9
 

@@ -4,7 +4,7 @@
         [--systems 2-in-2-out 1-in-2-out 2-in-1-out] [--methods wgtls sml] [--seed 1]
         [--noise auto|sample|moderated] [--colour a]
 
-For each system of lptv.mimo_examples (two masses with a periodic coupling spring, 2 inputs and
+For each system of lptv.examples.mimo (two masses with a periodic coupling spring, 2 inputs and
 2 outputs or 1 input and 2 outputs; one mass with 2 inputs, a periodic input gain and an input
 derivative): an orthogonal (Hadamard) design with E = nu experiments on N = 128 samples, the
 noise-free periodic steady state of each experiment integrated once by solve_ivp, then per run
@@ -32,7 +32,7 @@ import warnings
 import numpy as np
 
 import lptv
-from lptv import mimo_examples as mx
+from lptv.examples import mimo as mx
 
 N = 128
 LINES = np.arange(2, 50, 3)

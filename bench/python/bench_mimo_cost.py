@@ -3,7 +3,7 @@ against the LAPACK floor of its main factorisation (METHOD.md section 19).
 
     OPENBLAS_NUM_THREADS=1 python bench/python/bench_mimo_cost.py [--rounds 15] [--n 128 512]
 
-The two-mass system with two inputs and two outputs (lptv.mimo_examples, FDS steady state, 3 %
+The two-mass system with two inputs and two outputs (lptv.examples.mimo, FDS steady state, 3 %
 noise on every channel, P = 8, Hadamard design with E = 2 experiments, lines 2..N/2-14 step 3)
 is fitted by lptv.identify with WGTLS and SML (covariance included); the yardstick is ny * nu =
 4 fits of a one-mass system (y'' + 0.8 y' + 4 (1 + 0.3 cos t) y = u) on the same lines, rows,
@@ -23,7 +23,7 @@ import numpy as np
 import scipy.linalg
 
 import lptv
-from lptv import mimo_examples as mx
+from lptv.examples import mimo as mx
 
 P = 8
 

@@ -104,7 +104,7 @@ SYSTEMS = {
 
 def main(runs=400, ct_runs=100):
     print(f"The verdict of one record: rejection rates over {runs} records ({ct_runs} continuous-time), "
-          f"nominal size {100 * lptv.record_verdict.ALPHA:g} %")
+          f"nominal size {100 * lptv.judgement.one_record_verdict.ALPHA:g} %")
     print(f"{'system':<17} {'structure':<36} {'rejected':>17} {'cost ratio (median)':>20}")
     for system, (make, structures) in SYSTEMS.items():
         n = ct_runs if system.startswith("continuous") else runs

@@ -66,8 +66,8 @@ def _structure(case, st):
 
 def one(args):
     system, P, seed, moderate, noise, cases = args
-    import lptv.verdict
-    lptv.verdict.MODERATE = moderate
+    import lptv.judgement.verdict
+    lptv.judgement.verdict.MODERATE = moderate
     rng = np.random.default_rng([seed, P, SYSTEMS.index(system)])
     out = []
     base = system_measurements(system, seed=rng, periods=P)

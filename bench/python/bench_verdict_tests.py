@@ -4,7 +4,7 @@ variances, paired (the same fits judged both ways).
 For each system and P, R realisations of the true structure fitted by WGTLS (the default; or
 SML with ``--method sml``); the
 verdict (METHOD.md section 7) is formed once on each line's own sample (co)variances
-(``lptv.verdict.MODERATE = False``) and once on the moderated ones (the default). Printed: the
+(``lptv.judgement.verdict.MODERATE = False``) and once on the moderated ones (the default). Printed: the
 family's size (any Holm-adjusted p-value below 1 %) with its binomial standard error, and per
 test the mean and standard deviation of its statistic (residue groups: N(0, 1); score tests:
 F(2, nu), mean and standard deviation about 1) and how often its own p-value falls below 5 %,
@@ -31,7 +31,7 @@ import numpy as np
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import lptv  # noqa: E402
-import lptv.verdict  # noqa: E402
+import lptv.judgement.verdict  # noqa: E402
 from lptv.examples import SYSTEMS, system_measurements  # noqa: E402
 
 
@@ -45,8 +45,8 @@ def one(args):
                             noise=noise, method=method)
     out = []
     for moderate in ((False, True) if noise == "sample" else (True,)):
-        lptv.verdict.MODERATE = moderate
-        t = lptv.verdict.residue_tests(res, res.structure)
+        lptv.judgement.verdict.MODERATE = moderate
+        t = lptv.judgement.verdict.residue_tests(res, res.structure)
         out.append((system, P, moderate, [(x.name, x.statistic, x.p_value, x.p_holm) for x in t.tests]))
     return out
 
@@ -68,12 +68,12 @@ def main(argv=None):
     print(f"# {len(tasks)} realisations, {args.method.upper()} weighed by {args.noise} noise, seed stream {args.stream}")
     for moderate in ((False, True) if args.noise == "sample" else (True,)):
         sel = [r for r in rows if r[2] == moderate]
-        rej = np.array([min(x[3] for x in r[3]) <= lptv.verdict.ALPHA for r in sel], float)
+        rej = np.array([min(x[3] for x in r[3]) <= lptv.judgement.verdict.ALPHA for r in sel], float)
         p = rej.mean()
         print(f"\n{'moderated' if moderate else 'sample'} variances: size {100 * p:.2f} +- "
               f"{100 * np.sqrt(p * (1 - p) / rej.size):.2f} % ({int(rej.sum())} of {rej.size})")
         for s in args.systems:
-            print("   " + "  ".join(f"{s} P={P}: {int(sum(min(x[3] for x in r[3]) <= lptv.verdict.ALPHA for r in sel if r[0] == s and r[1] == P))}"
+            print("   " + "  ".join(f"{s} P={P}: {int(sum(min(x[3] for x in r[3]) <= lptv.judgement.verdict.ALPHA for r in sel if r[0] == s and r[1] == P))}"
                                   f"/{sum(1 for r in sel if r[0] == s and r[1] == P)}" for P in args.periods))
         names = sorted({x[0] for r in sel for x in r[3]})
         for n in names:
@@ -84,7 +84,7 @@ def main(argv=None):
         why = {}
         for r in sel:
             for x in r[3]:
-                if x[3] <= lptv.verdict.ALPHA:
+                if x[3] <= lptv.judgement.verdict.ALPHA:
                     key = x[0] + (" (too small)" if x[1] < 0 and "harmonic" not in x[0] else "")
                     why.setdefault(key, []).append(f"{r[0][:5]}{r[1]}")
         for n, where in sorted(why.items()):
@@ -92,7 +92,7 @@ def main(argv=None):
         kk = np.array([len(r[3]) for r in sel])
         bonf = np.array([min(x[2] for x in r[3]) * k for r, k in zip(sel, kk)])
         print(f"   families whose smallest p-value is below 1 % / k (Bonferroni; k = {kk.min()}-{kk.max()} tests): "
-              f"{100 * np.mean(bonf <= lptv.verdict.ALPHA):.2f} %")
+              f"{100 * np.mean(bonf <= lptv.judgement.verdict.ALPHA):.2f} %")
         allp = np.array([x[2] for r in sel for x in r[3]])
         print(f"   pooled over the tests (n = {allp.size}): p<0.05 {np.mean(allp < 0.05):.4f} "
               f"p<0.01 {np.mean(allp < 0.01):.4f} p<0.001 {np.mean(allp < 0.001):.4f}")

@@ -42,7 +42,7 @@ import numpy as np
 
 import lptv
 from lptv import _core
-from lptv.data import FrequencyData
+from lptv.spectra.frequency_data import FrequencyData
 from lptv.examples import paper_measurements
 from lptv.reference import identification as ref
 
@@ -133,7 +133,7 @@ def main(n_seeds: int = 3, rounds: int = ROUNDS):
 def phases(n: int = 200):
     """lptv.identify split into the spectra from the periods, the compiled identify (estimate,
     covariance, residues, diagnostics), the stability check and the rest; and the estimate alone."""
-    mod = sys.modules["lptv.identify"]
+    mod = sys.modules["lptv.estimation.identify"]
     m = paper_measurements(1, periods=8)
     u, y, w0 = m["u"], m["y"], m["w0"]
     spent = {}

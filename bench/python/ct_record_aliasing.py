@@ -6,7 +6,7 @@ n - 1 (n = max(na, nb)) with real coefficients; the DFT of *samples* aliases the
 jump, so the identity holds only approximately. This script measures how well.
 
 A record of L whole parameter periods of a known continuous-time model is integrated with
-SUNDIALS CVODE (lptv.timedomain.free_response, rtol 1e-12) from a random initial state under a
+SUNDIALS CVODE (lptv.simulation.timedomain.free_response, rtol 1e-12) from a random initial state under a
 band-limited input: a sum of F sinusoids of random frequencies, uniform in (0, w_max), random
 phases, equal amplitudes. Its derivatives are exact, it is not periodic in the record, and it is
 band-limited, so for any sampling faster than 2 w_max its samples determine it (a zero-order
@@ -37,7 +37,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from lptv import timedomain  # noqa: E402
+from lptv.simulation import timedomain  # noqa: E402
 from lptv.examples import paper_model, third_order_model  # noqa: E402
 
 

@@ -26,40 +26,40 @@ The public API:
 - :func:`montecarlo`, :func:`identify_many` - Monte Carlo studies and many records at once, on
   local processes or a Dask cluster (:mod:`lptv.batch`);
 - :mod:`lptv.reference` - the same mathematics in plain NumPy;
-- :mod:`lptv.timedomain` - time integration with SUNDIALS CVODE.
+- :mod:`lptv.simulation.timedomain` - time integration with SUNDIALS CVODE.
 """
 from ._core import NumericalError
-from .fds import ConditioningWarning, SimulationResult, TruncationWarning, band_matrices, htf, simulate
-from .data import FrequencyData
-from .identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
-from .uncertainty import CramerRaoBound, crb
-from .nonparametric import HtfEstimate, htf_estimate
-from .distortion import DistortionResult, LackOfFit, distortion
-from .record import RecordResult, identify_record
-from .floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
-from .selection import SelectionResult, select
-from .measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
-from .inspection import Inspection, LineClass, inspect
-from .model import Model
-from .mimo import MimoModel
-from .mimo_multisine import MimoMultisines, mimo_multisines
-from .mimo_htf import MimoHtfEstimate, mimo_htf_estimate
-from .mimo_data import MimoFrequencyData
-from .mimo_result import MimoIdentificationResult
-from .mimo_identify import MimoCramerRaoBound, mimo_crb
-from .parameters import compare, freqresp_band, lti_table, parameter_table
-from .validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
-from .multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
+from .simulation.fds import ConditioningWarning, SimulationResult, TruncationWarning, band_matrices, htf, simulate
+from .spectra.frequency_data import FrequencyData, LineCorrelation, correlated_lines
+from .estimation.identify import METHODS, IdentifiabilityWarning, IdentificationResult, identify
+from .estimation.crb import CramerRaoBound, crb
+from .spectra.htf_estimate import HtfEstimate, htf_estimate
+from .spectra.distortion import DistortionResult, LackOfFit, distortion
+from .estimation.one_record import RecordResult, identify_record
+from .model.floquet import FloquetResult, StabilityUndecidedWarning, UnstableModelWarning, floquet
+from .batch.selection import SelectionResult, select
+from .records.measurements import Measurements, RecordCheck, RecordWarning, check_record, read_measurements
+from .records.inspection import Inspection, LineClass, inspect
+from .model.siso import Model
+from .model.mimo import MimoModel
+from .excitation.mimo_multisine import MimoMultisines, mimo_multisines
+from .spectra.mimo_htf_estimate import MimoHtfEstimate, mimo_htf_estimate
+from .spectra.mimo_frequency_data import MimoFrequencyData
+from .judgement.mimo_result import MimoIdentificationResult
+from .estimation.mimo_identify import MimoCramerRaoBound, mimo_crb
+from .judgement.parameters import compare, freqresp_band, lti_table, parameter_table
+from .judgement.validation import expected_fraction_above_0db, frozen_poles, frozen_zeros, normalized_residue
+from .excitation.multisine import (CrestDesign, ExcitationLines, Multisine, excitation_lines, min_crest_multisine,
                         multisine, multisine_realisations, schroeder_multisine, spectrum, time_signal)
-from .moderation import ModeratedNoise, moderated_noise
-from .disturbances import Disturbance, DisturbanceResult, disturbances
+from .spectra.moderation import ModeratedNoise, moderated_noise
+from .spectra.disturbances import Disturbance, DisturbanceResult, disturbances
 from .batch import BatchResult, MonteCarloResult, identify_many, montecarlo
 from .use import CoefficientTest, ValidationResult, predict, validate
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "BatchResult", "ConditioningWarning", "CramerRaoBound", "DistortionResult", "distortion", "LackOfFit", "FloquetResult", "FrequencyData", "HtfEstimate", "IdentifiabilityWarning", "METHODS",
+    "BatchResult", "ConditioningWarning", "CramerRaoBound", "DistortionResult", "distortion", "LackOfFit", "FloquetResult", "FrequencyData", "LineCorrelation", "correlated_lines", "HtfEstimate", "IdentifiabilityWarning", "METHODS",
     "IdentificationResult", "Model", "MonteCarloResult", "Multisine", "NumericalError", "SimulationResult", "StabilityUndecidedWarning", "TruncationWarning", "UnstableModelWarning",
     "band_matrices", "crb", "expected_fraction_above_0db", "floquet", "frozen_poles", "frozen_zeros", "htf", "htf_estimate",
     "identify", "identify_many", "montecarlo", "normalized_residue", "read_measurements", "Measurements", "multisine",

@@ -981,7 +981,7 @@ def python_cases():
         Case("frozen_poles-mimo-zero-row", "value", lambda: lp().frozen_poles(mimo(a=zero_row), [0.0]),
              match=names("model")),
         Case("monodromy-mimo-steps", "range",
-             lambda: importlib.import_module("lptv.floquet").monodromy(mimo(), steps=0), match=names("steps")),
+             lambda: importlib.import_module("lptv.model.floquet").monodromy(mimo(), steps=0), match=names("steps")),
         Case("read_measurements-u-list-int", "type",
              lambda: lp().read_measurements(good_npz(), u=["u", 3], y=["y", "w0"]), match=names("u")),
         Case("read_measurements-y-list-empty", "size", lambda: lp().read_measurements(good_npz(), y=[]),

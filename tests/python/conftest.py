@@ -258,7 +258,7 @@ def id_tol():
 # ==================================================================================================
 
 # Hill's multipliers against the eigenvalues of the product of matrix exponentials
-# (lptv.floquet.monodromy, sixth order), relative to ||Phi||_2: the product with 2000 steps is
+# (lptv.model.floquet.monodromy, sixth order), relative to ||Phi||_2: the product with 2000 steps is
 # within ~1e-13 ||Phi|| of the exact Phi (the test checks ||Phi_2000 - Phi_4000|| <=
 # FLOQUET_PRODUCT_STEP ||Phi||), eig(Phi) adds about eps ||Phi|| kappa_i with the eigenvalue
 # condition numbers kappa_i <= FLOQUET_KAPPA_MAX (checked), and Hill's exponents carry at
@@ -269,7 +269,7 @@ FLOQUET_VS_PRODUCT = 1e-10
 FLOQUET_PRODUCT_STEP = 1e-12
 FLOQUET_KAPPA_MAX = 1e3
 
-# The monodromy of lptv.timedomain's CVODE shooting, in units of its rtol, relative to
+# The monodromy of lptv.simulation.timedomain's CVODE shooting, in units of its rtol, relative to
 # ||Phi||_2: CVODE keeps each step's local error below rtol |x| + atol; over one period of a
 # modestly damped model (|mu| >= 0.05, so nothing decays below atol) the global error is a
 # modest multiple of rtol. Measured 1-14 rtol over 8 models at rtol 1e-8, 1e-10, 1e-12.

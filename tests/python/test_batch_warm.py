@@ -198,7 +198,7 @@ def test_malloc_kept_keeps_the_bits_and_the_pages(tmp_path):
         from lptv.batch import warm
         from lptv.batch.study import realisation
         from lptv.examples import paper_model, paper_multisine
-        from lptv.multisine import time_signal
+        from lptv.excitation.multisine import time_signal
         m, ms = paper_model(), paper_multisine(seed=1)
         y0 = time_signal(lptv.simulate(m, ms.spectrum), ms.n_samples)
         design = dict(u0=ms.signal, y0=y0, w0=m.w0, ts=None, periods=8, methods=("wgtls",),

@@ -155,7 +155,7 @@ def test_docstring_examples_run():
     import doctest
     import sys
 
-    result = doctest.testmod(sys.modules["lptv.distortion"], optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.testmod(sys.modules["lptv.spectra.distortion"], optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0
 
 

@@ -1,10 +1,10 @@
-"""covariance='bootstrap' of lptv.identify (python/lptv/bootstrap.py): its draws have the data's
+"""covariance='bootstrap' of lptv.identify (python/lptv/estimation/bootstrap.py): its draws have the data's
 noise statistics, and its standard deviations agree with a Monte Carlo of the estimator."""
 import numpy as np
 import pytest
 
 import lptv
-from lptv.bootstrap import draw
+from lptv.estimation.bootstrap import draw
 from lptv.examples import noisy_periods
 
 

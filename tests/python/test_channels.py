@@ -14,7 +14,7 @@ import scipy.io
 
 import lptv
 from lptv.apps import cli
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 FS, T0, P = 8.0, 8.0, 4          # 64 samples per period
 N = int(FS * T0)

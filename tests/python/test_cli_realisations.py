@@ -15,7 +15,7 @@ import pytest
 import lptv
 from lptv.apps import cli
 from lptv.examples import noisy_periods
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 MODEL = lptv.Model([[0.3 + 0.1j, 2.0, 0.3 - 0.1j], [0, 1.0, 0]], [[0, 1.0, 0]], w0=0.05)
 ARGS = ["--na", "1", "--nb", "0", "--ka", "1", "--kb", "1"]

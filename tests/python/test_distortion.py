@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import lptv
-import lptv.timedomain as td
+import lptv.simulation.timedomain as td
 from lptv.examples import THIRD_ORDER_EXCITED, noisy_periods, paper_model, third_order_model
 
 SYSTEMS = {

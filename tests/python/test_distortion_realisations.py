@@ -14,7 +14,7 @@ import pytest
 from scipy import stats
 
 import lptv
-from lptv.identify import realisation_covariance
+from lptv.estimation.identify import realisation_covariance
 from lptv.examples import PAPER_EXCITED, PAPER_N, noisy_periods, paper_model
 
 ROWS = [range(1, 244)] * 6

@@ -196,5 +196,5 @@ def test_docstring_examples_run():
     import doctest
     import sys
 
-    result = doctest.testmod(sys.modules["lptv.multisine"], optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.testmod(sys.modules["lptv.excitation.multisine"], optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted >= 8 and result.failed == 0

@@ -1,7 +1,7 @@
 """Floquet stability (METHOD.md section 12): Hill's method in the core against independent routes.
 
-- the product of short-interval matrix exponentials (lptv.floquet.monodromy, continuous time);
-- the monodromy matrix of lptv.timedomain's CVODE shooting (modestly damped models);
+- the product of short-interval matrix exponentials (lptv.model.floquet.monodromy, continuous time);
+- the monodromy matrix of lptv.simulation.timedomain's CVODE shooting (modestly damped models);
 - the product of the one-step companion matrices in NumPy (discrete time);
 - the poles of LTI models; the damped Mathieu equation's first instability tongue.
 
@@ -19,10 +19,10 @@ import pytest
 import scipy.linalg
 
 import lptv
-import lptv.timedomain as td
+import lptv.simulation.timedomain as td
 from conftest import _coefficient_row  # the random stable coefficient rows the FDS tests use
 from lptv.examples import mathieu_model, noisy_periods
-from lptv.floquet import monodromy
+from lptv.model.floquet import monodromy
 from lptv.reference import simulate as reference_simulate
 
 CT_SEEDS = [0, 1, 2, 3, 4, 5]
@@ -302,6 +302,6 @@ def test_readme_mathieu_example_runs():
 
 def test_docstring_examples_run():
     # lptv.floquet is the function once the package is imported; the module is in sys.modules.
-    module = importlib.import_module("lptv.floquet")
+    module = importlib.import_module("lptv.model.floquet")
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0

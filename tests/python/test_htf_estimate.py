@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 import lptv
-import lptv.nonparametric
+import lptv.spectra.htf_estimate
 from lptv.reference import fds as ref
 
 from conftest import random_model
@@ -93,7 +93,7 @@ def test_lines_too_close_for_the_branches_are_refused():
 
 
 def test_docstring_examples_run():
-    assert doctest.testmod(lptv.nonparametric, raise_on_error=False).failed == 0
+    assert doctest.testmod(lptv.spectra.htf_estimate, raise_on_error=False).failed == 0
 
 
 def test_plot_draws_every_branch_and_the_model():
@@ -112,7 +112,7 @@ def test_plot_draws_every_branch_and_the_model():
 def start_up_record(seed, P=8, snr_db=None):
     """A discrete-time record from rest (a start-up transient in the first periods): a constant
     denominator and one harmonic on the numerator, so the branches -1..1 are exact."""
-    import lptv.timedomain as td
+    import lptv.simulation.timedomain as td
 
     model = random_model(seed, "dt", ka=0, kb=1)
     N = model.samples_per_period

@@ -138,7 +138,7 @@ def test_a_record_that_does_not_repeat_is_said_to_and_the_one_record_route_named
 
 
 def test_a_dead_input_is_refused_as_dead():
-    with pytest.raises(lptv.channels.FileError, match="constant: a dead or disconnected input channel"):
+    with pytest.raises(lptv.records.channels.FileError, match="constant: a dead or disconnected input channel"):
         lptv.inspect(u=np.full(1000, 0.3), y=np.random.default_rng(0).standard_normal(1000), fs=10.0)
 
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import lptv
-from lptv import mimo_examples as mx
-from lptv.mimo_data import MimoFrequencyData
+from lptv.examples import mimo as mx
+from lptv.spectra.mimo_frequency_data import MimoFrequencyData
 from lptv.reference import mimo_fit as ref
 
 N = 32
@@ -93,8 +93,8 @@ def test_sml_and_covariances_match_reference(system, seed):
     cov_ref = np.linalg.inv(ref.fisher(st, res.eta, data))
     cov = res.covariance[np.ix_(free, free)] / res.covariance_factor
     assert np.allclose(cov, cov_ref, rtol=1e-8, atol=1e-10 * np.abs(cov_ref).max())
-    from lptv.mimo_fit import core_data, core_structure, sandwich
-    from lptv.mimo_data import MimoStructure
+    from lptv.estimation.mimo_fit import core_data, core_structure, sandwich
+    from lptv.spectra.mimo_frequency_data import MimoStructure
     datas = [MimoFrequencyData.from_periods(u, y, w0=mx.W0) for u, y in pairs]
     ny, nu = model.n_outputs, model.n_inputs
     s = STRUCTURE[system]
@@ -148,7 +148,7 @@ def test_noise_free_solve_ivp_gives_true_coefficients(system):
     a, b = mx.true_parameters(model)
     s = STRUCTURE[system]
     ny, nu = model.n_outputs, model.n_inputs
-    from lptv.mimo_data import MimoStructure
+    from lptv.spectra.mimo_frequency_data import MimoStructure
     st = MimoStructure(s["na"], s["nb"], counts(s["ka"], s["na"], ny), counts(s["kb"], s["nb"], nu), ny, nu, mx.W0)
     truth = st.xi_of(a, b)
     # the integration's relative error (about 1e-13 of the largest output line, bounded by 10 rtol
@@ -233,11 +233,11 @@ def test_bad_inputs_name_the_argument(call, word):
 
 def test_docstring_examples_run():
     import doctest
-    import lptv.mimo_data
-    import lptv.mimo_examples
-    import lptv.mimo_identify
-    import lptv.mimo_result
-    for mod in (lptv.mimo_data, lptv.mimo_examples, lptv.mimo_identify, lptv.mimo_result):
+    import lptv.spectra.mimo_frequency_data
+    import lptv.examples.mimo
+    import lptv.estimation.mimo_identify
+    import lptv.judgement.mimo_result
+    for mod in (lptv.spectra.mimo_frequency_data, lptv.examples.mimo, lptv.estimation.mimo_identify, lptv.judgement.mimo_result):
         result = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
         assert result.attempted > 0 and result.failed == 0, mod.__name__
     # lptv.identify's own examples, the MIMO one included
@@ -296,7 +296,7 @@ def test_discrete_time_matches_reference(method, seed):
         assert np.abs(res.eta - xi_ref)[st.free].max() <= 1e-4 * std[st.free].min()
     # the estimate is near the truth (a few standard deviations: the data are noisy)
     a, b = model.a, model.b
-    from lptv.mimo_data import MimoStructure
+    from lptv.spectra.mimo_frequency_data import MimoStructure
     truth = MimoStructure(2, 0, counts([1, 0, 0], 2, 2), counts(0, 0, 2), 2, 2, model.w0, 1.0).xi_of(a, b)
     free = st.free
     assert np.all(np.abs(res.eta - truth)[free] <= 6 * res.parameter_std[free])
@@ -364,7 +364,7 @@ def test_prediction_of_a_fresh_experiment(system):
     U = d.spectra[0]
     pred = np.asarray(lptv.simulate(res.model, U, lines_out=n // 2)).reshape(n // 2 + 1, -1)
     rng = np.random.default_rng(0)
-    from lptv.mimo_data import MimoStructure
+    from lptv.spectra.mimo_frequency_data import MimoStructure
     s = STRUCTURE[system]
     st = MimoStructure(s["na"], s["nb"], counts(s["ka"], s["na"], model.n_outputs),
                        counts(s["kb"], s["nb"], model.n_inputs), model.n_outputs, model.n_inputs, mx.W0)

@@ -21,7 +21,7 @@ from scipy.linalg import eig
 from scipy.optimize import linear_sum_assignment
 
 import lptv
-from lptv.floquet import monodromy
+from lptv.model.floquet import monodromy
 from conftest import (MIMO_FLOQUET_DT, MIMO_FLOQUET_IVP_RTOL, MIMO_FLOQUET_KAPPA_MAX, MIMO_FLOQUET_MARGIN,
                       MIMO_FLOQUET_SISO, MIMO_FLOQUET_VS_IVP, MIMO_FROZEN_POLES, SEEDS)
 
@@ -163,7 +163,7 @@ DT_MEANS = dict(al=0.1, f=0.1, e=-0.5, h=0.1, g=0.1, k=0.81, c=-1.2)     # roots
 
 
 def test_simulate_warns_for_an_unstable_matrix_model():
-    """simulate's stability check (lptv.floquet.stability_check) on the pumped two masses: the
+    """simulate's stability check (lptv.model.floquet.stability_check) on the pumped two masses: the
     periodic solution is returned either way, with UnstableModelWarning above the tongue's edge."""
     import warnings
 
@@ -185,7 +185,7 @@ def test_an_undamped_system_is_marginal_neither_stable_nor_reported_unstable():
     """C = 0, K constant: every multiplier on the unit circle. The products' radii sit at 1 and
     never settle, Hill's method decides: not stable (marginal), and simulate's check reports
     nothing (neither unstable nor undecided)."""
-    from lptv.floquet import stability_check
+    from lptv.model.floquet import stability_check
 
     model = lptv.MimoModel.mechanical(np.diag([1.0, 2.0]), np.zeros((2, 2)), [[7.0, -2.0], [-2.0, 5.0]],
                                       np.eye(2), w0=1.0)
@@ -462,10 +462,10 @@ def test_a_singular_leading_matrix_and_a_zero_row_are_refused_naming_where():
 
 
 def test_docstring_examples_run():
-    """lptv.floquet's examples (the two masses pumped at 2 sqrt(3)) run in test_floquet.py; the
+    """lptv.model.floquet's examples (the two masses pumped at 2 sqrt(3)) run in test_floquet.py; the
     frozen poles' here."""
     import doctest
     import importlib
 
-    result = doctest.testmod(importlib.import_module("lptv.validation"), optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.testmod(importlib.import_module("lptv.judgement.validation"), optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0

@@ -9,7 +9,7 @@ import pytest
 import scipy.io
 
 import lptv
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 FS, T0, P = 16.0, 4.0, 5          # 64 samples per period
 N = int(FS * T0)

@@ -11,7 +11,7 @@ import pytest
 
 import lptv
 from lptv import _core
-from lptv.mimo_data import MimoFrequencyData
+from lptv.spectra.mimo_frequency_data import MimoFrequencyData
 from lptv.reference import moderation as ref
 
 
@@ -107,7 +107,7 @@ def test_moderated_matrices_near_the_true_covariance(seed):
     L, P = 400, 4
     d, true = _noise(L, P, 3, seed, "coloured")
     mo = lptv.moderated_noise(d)
-    assert isinstance(mo, lptv.mimo_moderation.MimoModeratedNoise)
+    assert isinstance(mo, lptv.spectra.mimo_moderation.MimoModeratedNoise)
     assert mo.prior_dof > 2 * (P - 1)
     inner = np.arange(1, L)
     tv = np.real(np.diagonal(true, axis1=1, axis2=2))[inner]
@@ -136,10 +136,10 @@ def test_spike_keeps_its_own_and_rough_noise_is_not_smooth():
     mo = lptv.moderated_noise(d)
     assert 100 in mo.outliers
     assert np.array_equal(mo.data.C[100], d.C[100])
-    ok, why = lptv.moderation.smooth_noise(mo)
+    ok, why = lptv.spectra.moderation.smooth_noise(mo)
     assert ok, why
     rough, _ = _noise(300, 8, 3, 5, "rough")
-    ok, why = lptv.moderation.smooth_noise(lptv.moderated_noise(rough))
+    ok, why = lptv.spectra.moderation.smooth_noise(lptv.moderated_noise(rough))
     assert not ok and "not smooth" in why
 
 

@@ -206,12 +206,12 @@ def test_identify_with_moderated_noise_weighs_by_it_and_reports_its_periods(seed
 
 
 def test_the_verdict_of_a_moderated_fit_does_not_moderate_again(monkeypatch):
-    import lptv.moderation
+    import lptv.spectra.moderation
     d = _system(seed=4)
     res = _fit(d, method="wgtls", noise="moderated")
     calls = []
-    real = lptv.moderation.moderated_noise
-    monkeypatch.setattr(lptv.moderation, "moderated_noise", lambda *a, **k: calls.append(1) or real(*a, **k))
+    real = lptv.spectra.moderation.moderated_noise
+    monkeypatch.setattr(lptv.spectra.moderation, "moderated_noise", lambda *a, **k: calls.append(1) or real(*a, **k))
     assert res.residue_tests is not None
     assert calls == []
     ref = _fit(d, method="wgtls")
@@ -233,9 +233,9 @@ def test_moderated_noise_with_several_experiments():
 def test_docstring_examples_run():
     import doctest
 
-    import lptv.moderation
+    import lptv.spectra.moderation
 
-    result = doctest.testmod(lptv.moderation, optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.testmod(lptv.spectra.moderation, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0
 
 
@@ -316,7 +316,7 @@ def test_the_default_route_keeps_the_sample_variances_below_four_periods_and_for
 
 
 def test_the_smoothness_check_names_its_numbers():
-    from lptv.moderation import smooth_noise
+    from lptv.spectra.moderation import smooth_noise
     L = 300
     rng = np.random.default_rng(5)
     v = 10 ** rng.uniform(-3, -1, (2, L + 1))
@@ -333,7 +333,7 @@ def test_the_smoothness_check_finds_bumps_a_few_lines_wide(seed):
     """Noise whose variance has 20 bumps about three lines wide (a factor up to 5) on a flat floor:
     scattered about no smooth trend, neighbouring lines' residuals correlate and the check fails
     by that criterion; the same noise without the bumps passes."""
-    from lptv.moderation import smooth_noise
+    from lptv.spectra.moderation import smooth_noise
     L = 300
     l = np.arange(L + 1)
     rng = np.random.default_rng(seed)

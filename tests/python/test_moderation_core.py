@@ -94,7 +94,7 @@ def test_core_agrees_with_the_reference(name):
         assert core.prior_dof == 0 and core.data is d and r.data is d
         assert core.own_weight is None and core.neighbour is None
     elif r.prior_dof == ref.MAX_PRIOR_DOF:
-        assert core.prior_dof == lptv.moderation.MAX_PRIOR_DOF == r.prior_dof
+        assert core.prior_dof == lptv.spectra.moderation.MAX_PRIOR_DOF == r.prior_dof
     else:
         assert abs(core.prior_dof - r.prior_dof) <= 1e-8 * r.prior_dof, (core.prior_dof, r.prior_dof)
     assert np.max(_rel(core.dof, r.dof)) <= 1e-10

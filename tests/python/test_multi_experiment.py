@@ -356,7 +356,7 @@ def test_experiments_that_disagree_are_refused():
     with pytest.raises(ValueError, match=r"experiment 1: lines: row 40"):
         lptv.identify([d1, d1], **kw, lines=[None, [5, 40]])
     with pytest.raises(ValueError, match="experiments must be a list"):
-        lptv.data.experiments_of({"a": d1}, None, None)
+        lptv.spectra.frequency_data.experiments_of({"a": d1}, None, None)
 
 
 # ------------------------------------------------------------------------- the command line

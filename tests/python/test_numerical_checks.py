@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import lptv
-from lptv import timedomain as td
+from lptv.simulation import timedomain as td
 from lptv.examples import mathieu_model, paper_model, paper_multisine
 
 # The damped steady state against B(jw)/A(jw): CVODE's rtol = 1e-12 accumulates over the ~1/zeta
@@ -29,7 +29,7 @@ def _exact_line(num, den, w):
     return np.polyval(num[::-1], 1j * w) / np.polyval(den[::-1], 1j * w)
 
 
-# ------------------------------------------------------------- shooting (lptv.timedomain)
+# ------------------------------------------------------------- shooting (lptv.simulation.timedomain)
 @pytest.mark.parametrize("w0, wn", [(1.0, 1.0), (0.5, 1.0), (1.0, 3.0)])
 def test_shooting_refuses_an_undamped_resonance_on_a_harmonic(w0, wn):
     # y'' + wn^2 y = u with wn a multiple of w0: Phi = I up to CVODE's error, so ||I - Phi|| is
@@ -188,7 +188,7 @@ def test_fds_silent_for_a_resolved_resonance(damping):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         r = lptv.simulate(lptv.Model(den, [1.0], w0=1.0), _line1(), full_output=True)
-    assert r.condition < lptv.fds.CONDITION_WARN
+    assert r.condition < lptv.simulation.fds.CONDITION_WARN
     ref = 0.5 * _exact_line([1.0], den, 1.0)
     assert abs(r.Y[1] - ref) <= 10 * r.condition * EPS * abs(ref)
 

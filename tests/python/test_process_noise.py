@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import lptv
-from lptv.data import correlated_lines
+from lptv import correlated_lines
 
 import process_rig as rig
 

@@ -143,7 +143,7 @@ def test_bad_input(kwargs, match):
 def test_docstring_examples_run():
     import doctest
 
-    import lptv.record
+    import lptv.estimation.one_record
 
-    result = doctest.testmod(lptv.record, optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.testmod(lptv.estimation.one_record, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0

@@ -1,6 +1,6 @@
 """One record of a continuous-time LPTV system: lptv.identify_record(..., continuous=True).
 
-The records come from SUNDIALS CVODE (lptv.examples.continuous_record: lptv.timedomain.
+The records come from SUNDIALS CVODE (lptv.examples.continuous_record: lptv.simulation.timedomain.
 free_response at rtol 1e-12, a random initial state, a band-limited sum of 200 sinusoids up
 to 4 rad/s, L = 2 periods of the third-order example), not from the FDS the estimator uses.
 1312 samples per period put the fitted band (lines 1..163 of the default, 4.1 rad/s with the

@@ -10,7 +10,7 @@ import pytest
 
 import lptv
 from lptv.apps import cli
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 LPTV = [sys.executable, "-m", "lptv"]
 
@@ -98,7 +98,7 @@ def test_lines_past_nyquist_are_named_before_any_allocation():
 
 def test_select_refuses_a_grid_above_its_bound_before_any_fit():
     from lptv.examples import paper_measurements
-    from lptv.selection import MAX_GRID
+    from lptv.batch.selection import MAX_GRID
 
     d = paper_measurements(seed=1, periods=4)
     with pytest.raises(ValueError, match=rf"68921 structures .* more than lptv.selection.MAX_GRID = {MAX_GRID}"):

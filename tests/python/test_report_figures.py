@@ -5,7 +5,7 @@ k(t) = 40 (1 + 0.3 cos(2 pi t / 5)) N/m, integrated by scipy's solve_ivp under a
 30 adjacent lines 1..30 (0.2-6 Hz), 8 periods of 5 s at 200 Hz after 4 periods of start-up, 1 %
 noise on both channels, written as ``time [s],force [N],displacement [m]``. Measured spectra are
 taken by NumPy's FFT of the periods here, the model's prediction by CVODE's periodic steady state
-(lptv.timedomain), the test's thresholds by scipy.stats: none of them is the code that draws.
+(lptv.simulation.timedomain), the test's thresholds by scipy.stats: none of them is the code that draws.
 """
 import json
 import re
@@ -105,7 +105,7 @@ def test_lptv_bode_draws_measured_y_over_u_against_the_models_prediction_within_
     scatter around the prediction as the noise says (their squared normalised distances sum to
     less than the REPORT_CHI_LEVEL quantile of a Gamma(n)); the branch G_0 alone, which the plot
     used to draw, misses them on the rig by far more."""
-    from lptv import timedomain
+    from lptv.simulation import timedomain
 
     if case == "rig":
         _, u, y = rig

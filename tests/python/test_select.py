@@ -150,7 +150,7 @@ def test_docstring_example():
     import doctest
     import sys
 
-    module = sys.modules["lptv.selection"]
+    module = sys.modules["lptv.batch.selection"]
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert result.attempted > 0 and result.failed == 0
 

@@ -1,6 +1,6 @@
 """The frequency-domain simulator against time-domain routes that share none of its code.
 
-Continuous time: SUNDIALS CVODE (lptv.timedomain) integrates the ODE to periodic steady state;
+Continuous time: SUNDIALS CVODE (lptv.simulation.timedomain) integrates the ODE to periodic steady state;
 discrete time: scipy.signal.lfilter (LTI) and the plain forward recursion (LPTV).
 """
 import numpy as np
@@ -9,7 +9,7 @@ from scipy import signal
 
 import lptv
 import lptv.examples as ex
-from lptv import timedomain as td
+from lptv.simulation import timedomain as td
 
 # CVODE at rtol = 1e-12 (Adams): over one 157 s period of the paper example (~10^4 steps) its
 # global error stays near 1e-11 of the signal (about -220 dB measured); the FDS with its adaptive

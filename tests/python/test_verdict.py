@@ -1,4 +1,4 @@
-"""The verdict's residue tests (lptv.verdict, METHOD.md section 7) and the bounded stability
+"""The verdict's residue tests (lptv.judgement.verdict, METHOD.md section 7) and the bounded stability
 check (METHOD.md section 15). Size and power over many realisations: bench/python/bench_verdict.py."""
 import subprocess
 import sys
@@ -90,9 +90,9 @@ def test_leverage_sums_to_half_the_parameters_for_an_lti_model(monkeypatch):
     computation through S_r = (I - Pi) S (I - Pi)^T must reproduce). It needs W = diag(S)^-1,
     so S from the same (sample) variances as the fit's weights: the moderated variances are
     switched off here (with them S and W differ by design, METHOD.md section 7)."""
-    import lptv.verdict
+    import lptv.judgement.verdict
 
-    monkeypatch.setattr(lptv.verdict, "MODERATE", False)
+    monkeypatch.setattr(lptv.judgement.verdict, "MODERATE", False)
     m = lptv.Model([[2.0], [1.0], [0.5]], [[1.0], [0.3]], w0=0.1)
     ms = lptv.multisine(range(1, 60), 256, seed=0)
     y1 = lptv.time_signal(lptv.simulate(m, ms.spectrum), 256)
@@ -131,7 +131,7 @@ def test_prediction_check_counts_input_noise_and_parameter_uncertainty():
 SLOW_HILL = textwrap.dedent("""
     import time, warnings, numpy as np, lptv
     from lptv.examples import paper_measurements
-    from lptv.floquet import stability_check
+    from lptv.model.floquet import stability_check
     # a_4(t) = 1 + 0.95 cos(w0 t): Hill's method took 46 s on this model (M = 256, not converged)
     a = np.zeros((5, 3), complex); a[:, 1] = [1, 2, 2, 1, 1]; a[4, 0] = a[4, 2] = 0.475
     m = lptv.Model(a, [[1.0]], w0=0.04)
@@ -217,7 +217,7 @@ def test_the_verdicts_moderated_variances_are_unbiased_where_the_noise_is_flat()
         d = system_measurements("discrete", seed=seed, periods=4)
         data = lptv.FrequencyData.from_periods(d["u"], d["y"], w0=d["w0"], ts=d["ts"])
         mo = lptv.moderated_noise(data)
-        if not 2 < mo.prior_dof < lptv.moderation.MAX_PRIOR_DOF:
+        if not 2 < mo.prior_dof < lptv.spectra.moderation.MAX_PRIOR_DOF:
             continue
         true = noise_variances(d["u0"], d["y0"], **d["noise"])[1] / 4
         inner = slice(1, np.asarray(data.varY).size - 1)

@@ -13,7 +13,7 @@ import scipy.signal
 
 import lptv
 from lptv.apps import cli
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 FS, T0 = 100.0, 10.0
 N = int(FS * T0)
@@ -155,7 +155,7 @@ def test_the_wrong_model_is_rejected_whatever_the_fraction_on_all_lines(record, 
 def test_excited_lines_of_an_lptv_model_reach_plus_minus_k(record):
     u, y = record
     d = lptv.FrequencyData.from_periods(u, y, w0=W0)
-    from lptv.identify import excited_rows
+    from lptv.estimation.identify import excited_rows
 
     np.testing.assert_array_equal(excited_rows(d), np.arange(1, 51))
     np.testing.assert_array_equal(excited_rows(d, K=2), np.arange(3, 53))

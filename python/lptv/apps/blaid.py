@@ -43,7 +43,7 @@ from lptv import NumericalError, distortion, identify, parameter_table, plots
 from lptv.apps.options import verdict_status
 from lptv.apps import units
 from lptv.apps.report import Report, model_figures, parameter_section, write_fit
-from lptv.parameters import format_parameter_table
+from lptv.judgement.parameters import format_parameter_table
 
 
 def _fail(src, problem) -> int:

@@ -31,7 +31,7 @@ from lptv.apps.options import parse_lines, positive
 from lptv.apps.options import bounded_range, in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import write_json
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 
 GRID_MAX = 10_000

@@ -24,7 +24,7 @@ import numpy as np
 
 from lptv import crb, floquet, frozen_poles, frozen_zeros, identify, plots, simulate
 from lptv.apps.report import Report, write_json
-from lptv.examples import (mathieu_model, noise_variances, PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, PAPER_NOISE, PAPER_SNR_IN_DB,
+from lptv.examples.siso import (mathieu_model, noise_variances, PAPER_EXCITED, PAPER_ID_LINES, PAPER_N, PAPER_NOISE, PAPER_SNR_IN_DB,
                            PAPER_SNR_OUT_DB, noisy_periods, paper_measurements)
 
 
@@ -60,7 +60,7 @@ def run(args) -> int:
          f"N = {PAPER_N}, crest factor {data['multisine'].crest_factor:.2f}")
 
     # --- FDS against CVODE (Fig. 2) ---
-    from lptv import timedomain
+    from lptv.simulation import timedomain
 
     Y_fds, t_fds = _time_fds(model, U0)
     ss = timedomain.periodic_steady_state(model, U0, PAPER_N, full_output=True)

@@ -56,8 +56,8 @@ from lptv.apps.options import verdict_status
 from lptv.apps import units
 from lptv.apps.report import Report, write_fit
 from lptv import METHODS
-from lptv.parameters import format_parameter_table
-from lptv.measurements import FileError
+from lptv.judgement.parameters import format_parameter_table
+from lptv.records.measurements import FileError
 
 # ------------------------------------------------------------------------------ options
 

@@ -28,7 +28,7 @@ import numpy as np
 from lptv import inspect, plots
 from lptv.apps.options import in_option_terms, output_folder
 from lptv.apps.report import PLOTS_EXTRA, Report, write_json
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 OPTION_NAMES = {"fs": "--fs", "dt": "--dt", "reach": "--reach"}
 

@@ -24,7 +24,7 @@ from lptv import FrequencyData, NumericalError, identify, parameter_table, plots
 from lptv.apps.options import fundamental, parse_counts, parse_known, parse_lines, positive, read_record
 from lptv.apps.options import verdict_status
 from lptv.apps.report import Report, model_figures, write_fit
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 
 def _fail(problem) -> int:

@@ -30,7 +30,7 @@ import numpy as np
 
 from lptv import FrequencyData, Model, identify, multisine, plots, simulate, time_signal
 from lptv.apps.report import Report, write_json
-from lptv.examples import noisy_periods
+from lptv.examples.siso import noisy_periods
 
 # --- case 1: the slides' static sensor model
 LS_X = np.linspace(0.0, 1.0, 101)          # the slides' x = 0:0.01:1

@@ -30,7 +30,7 @@ from lptv.apps.options import Interrupted, in_option_terms, integer, interruptib
 from lptv.batch.executors import LOST
 from lptv.batch.parts import CheckpointError, clear, stored_items
 from lptv.apps.report import write_json
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 
 MODEL_ERRORS = 3

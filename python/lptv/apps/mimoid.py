@@ -33,7 +33,7 @@ from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fun
                                output_folder, parse_counts, parse_lines, positive, read_options)
 from lptv.apps import inspectrec
 from lptv.apps.report import write_fit
-from lptv.measurements import FileError, read_measurements
+from lptv.records.measurements import FileError, read_measurements
 
 NEEDS_FIT = ("several inputs or outputs need the MIMO fit (lptv.identify on arrays (P, N, nu), (P, N, ny)), "
              "which this lptv does not have yet")

@@ -1,7 +1,7 @@
 """``report.html`` of ``lptv identify FILES --input f1,f2 --output x1,x2``: the verdict, the
 parameters with their standard deviations, each output's normalised residue over the lines of
 the fit, the estimate's Floquet multipliers and its frozen poles. Built from the public API
-only (:class:`lptv.mimo_result.MimoIdentificationResult`, :func:`lptv.floquet`,
+only (:class:`lptv.judgement.mimo_result.MimoIdentificationResult`, :func:`lptv.floquet`,
 :func:`lptv.frozen_poles`)."""
 from __future__ import annotations
 

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv.measurements import FileError, read_measurements
+from lptv.records.measurements import FileError, read_measurements
 
 INT_MAX = 2**31 - 1
 """The largest integer the core takes (a C int)."""

@@ -26,7 +26,7 @@ import numpy as np
 from lptv import NumericalError, identify_record, read_measurements
 from lptv.apps.options import in_option_terms, integer, output_folder
 from lptv.apps.report import Report, write_json
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 from lptv.use.modelfile import context_of
 
 MODEL_ERRORS = 3

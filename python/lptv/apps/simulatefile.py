@@ -21,7 +21,7 @@ import numpy as np
 from lptv import NumericalError, predict
 from lptv.apps.userecord import add_model_and_record, fail, load_model, read, time_column
 from lptv.atomic import atomic_open
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 
 def add_parser(sub):

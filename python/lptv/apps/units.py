@@ -18,7 +18,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 _COEF = re.compile(r"([ab])(\d+)")
 
@@ -123,7 +123,7 @@ def trajectories(src, t):
     (values, std or None, names), values and std of shape (len(t), na + nb + 2); the std from the
     parameter covariance (each coefficient is linear in the parameters: its derivative is the
     change for a unit step of one parameter)."""
-    from lptv.parameters import perturbed_model
+    from lptv.judgement.parameters import perturbed_model
 
     model = src.model
     names = [f"a{n}" for n in range(model.na + 1)] + [f"b{m}" for m in range(model.nb + 1)]

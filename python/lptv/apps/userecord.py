@@ -14,8 +14,8 @@ import numpy as np
 
 from lptv import MimoModel, Model, read_measurements
 from lptv.apps.options import in_option_terms, positive
-from lptv.channels import split_unit
-from lptv.measurements import FileError
+from lptv.records.channels import split_unit
+from lptv.records.measurements import FileError
 from lptv.use.predict import whole_periods
 
 

@@ -24,7 +24,7 @@ from lptv import NumericalError, validate
 from lptv.apps.options import MODEL_REJECTED, output_folder, parse_lines
 from lptv.apps.report import Report, write_json
 from lptv.apps.userecord import add_model_and_record, fail, load_model, read, time_column
-from lptv.measurements import FileError
+from lptv.records.measurements import FileError
 
 
 def add_parser(sub):

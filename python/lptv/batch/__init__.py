@@ -4,7 +4,9 @@
   by one or several methods; bias, variance against the Cramer-Rao bound, coverage.
 - :func:`lptv.identify_many` (:mod:`lptv.batch.records`): the same fit on many files or arrays,
   one row of results per record, failures reported in their row.
-- :func:`run_tasks` (:mod:`lptv.batch.executors`): the engine under both, for studies of your
+- :func:`lptv.select` (:mod:`lptv.batch.selection`): a grid of structures fitted on one data set
+  and ranked, guided by the HTF estimate;
+- :func:`run_tasks` (:mod:`lptv.batch.executors`): the engine under them all, for studies of your
   own: chunked tasks on ``"serial"``, ``"processes"`` (default) or a Dask cluster, results in
   order, a progress bar with an ETA.
 - :mod:`lptv.batch.warm`: the process pool kept between calls of lptv's own tasks (its

@@ -13,10 +13,10 @@ from typing import Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_positive_float
-from ..identify import COVARIANCES, METHODS, NOISES, _counts, _known_list, _rows, identify
+from ..estimation.identify import COVARIANCES, METHODS, NOISES, _counts, _known_list, _rows, identify
 from ..atomic import atomic_open, atomic_path
-from ..measurements import Measurements, read_measurements, read_options
-from ..model import Model
+from ..records.measurements import Measurements, read_measurements, read_options
+from ..model.siso import Model
 from .executors import Failure, describe_executor, require, run_tasks
 
 # The columns every row has, before the parameters (eta and eta.std by name).

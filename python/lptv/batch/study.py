@@ -15,13 +15,13 @@ from typing import Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from .._validate import as_float, as_int, as_path, as_real_1d
-from ..data import FrequencyData
-from ..examples import noise_variances, noisy_periods
-from ..fds import simulate
-from ..identify import METHODS, identify
-from ..model import Model
-from ..multisine import Multisine, spectrum, time_signal
-from ..uncertainty import CramerRaoBound, crb
+from ..spectra.frequency_data import FrequencyData
+from ..examples.siso import noise_variances, noisy_periods
+from ..simulation.fds import simulate
+from ..estimation.identify import METHODS, identify
+from ..model.siso import Model
+from ..excitation.multisine import Multisine, spectrum, time_signal
+from ..estimation.crb import CramerRaoBound, crb
 from .executors import Failure, describe_executor, run_tasks
 from .tables import MonteCarloTables
 

@@ -53,7 +53,7 @@ def warm_up():
     to one thread (the rounding every executor shares, see :mod:`lptv.batch.executors`)."""
     import importlib
 
-    for name in ("lptv", "lptv.batch.study", "lptv.batch.records", "lptv.selection", "scipy.signal"):
+    for name in ("lptv", "lptv.batch.study", "lptv.batch.records", "lptv.batch.selection", "scipy.signal"):
         try:
             importlib.import_module(name)
         except ImportError:   # pragma: no cover - the first task reports it in its rows

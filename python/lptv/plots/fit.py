@@ -129,9 +129,9 @@ def htf_branches(est, model=None, *, hz: bool = False, ax=None, guard: int = 60)
     hz : bool
         Frequency axis in Hz instead of rad/s.
     """
-    from ..fds import htf
-    from ..model import Model
-    from ..nonparametric import HtfEstimate
+    from ..simulation.fds import htf
+    from ..model.siso import Model
+    from ..spectra.htf_estimate import HtfEstimate
     from .._validate import as_bool, as_int
 
     if not isinstance(est, HtfEstimate):
@@ -216,7 +216,7 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
     >>> [ax.get_ylabel() for ax in fig.axes]
     ['|Y/U| (dB)', 'phase of Y/U (deg)', '|G_k| (dB)']
     """
-    from ..identify import IdentificationResult, excited_rows
+    from ..estimation.identify import IdentificationResult, excited_rows
     from .._validate import as_bool, as_float, as_int
 
     if not isinstance(res, IdentificationResult):
@@ -256,7 +256,7 @@ def bode(res, *, hz: bool = False, level: float = 0.95, n_points: int = 400, fig
     shown = []
     curve = None
     if lti:
-        from ..parameters import freqresp_band
+        from ..judgement.parameters import freqresp_band
 
         w_all = np.concatenate([s[2] for s in sets]) * model.w0
         wmax = np.pi / model.ts if model.discrete else w_all.max() * 1.5
@@ -350,8 +350,8 @@ def _predicted_ratio(res, d, rows):
     with the standard deviations of its magnitude and phase (rad) from the parameter covariance
     (central differences of the simulated output over the parameters, first order); the stds are
     None without a covariance."""
-    from ..fds import simulate
-    from ..parameters import perturbed_model
+    from ..simulation.fds import simulate
+    from ..judgement.parameters import perturbed_model
 
     model = res.model
     U = d.U[rows]
@@ -383,7 +383,7 @@ def _branch_color(k: int) -> str:
 def _branches_panel(ax, res, sets, scale, n_points):
     """The model's HTF branches over the excited band and, where the record determines them, their
     nonparametric estimates (lptv.htf_estimate) with +-2 std."""
-    from ..nonparametric import htf_estimate
+    from ..spectra.htf_estimate import htf_estimate
 
     model = res.model
     K = max(model.ka, model.kb)
@@ -444,7 +444,7 @@ def inspection(insp, *, hz: bool = False, fig=None):
     >>> fig.axes[0].get_title()
     'the input repeats every 2.00 s (200 samples)'
     """
-    from ..inspection import Inspection
+    from ..records.inspection import Inspection
     from .._validate import as_bool
 
     if not isinstance(insp, Inspection):
@@ -458,7 +458,7 @@ def inspection(insp, *, hz: bool = False, fig=None):
     lag = insp.lags[1:]
     x = lag / insp.fs if insp.fs else lag
     ax.semilogy(x, np.maximum(insp.repeat[1:], 1e-12), lw=0.8, color="C0", label="input: r(L)")
-    from ..inspection import REPEAT_LIMIT
+    from ..records.inspection import REPEAT_LIMIT
 
     ax.axhline(REPEAT_LIMIT, color="C3", ls="--", lw=1, label=f"limit of a period ({REPEAT_LIMIT:g})")
     if insp.repeats:

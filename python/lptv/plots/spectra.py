@@ -184,7 +184,7 @@ def lack_of_fit(lof, *, w0: Optional[float] = None, hz: bool = False, ax=None):
     >>> ax.get_ylabel()
     '-log10 p of the line'
     """
-    from ..distortion import LackOfFit
+    from ..spectra.distortion import LackOfFit
     from .._validate import as_bool, as_positive_float
 
     if not isinstance(lof, LackOfFit):
@@ -234,7 +234,7 @@ def distortion(d, *, hz: bool = False, ax=None):
     >>> ax.get_ylabel()
     'power (dB)'
     """
-    from ..distortion import DistortionResult
+    from ..spectra.distortion import DistortionResult
     from .._validate import as_bool
 
     if not isinstance(d, DistortionResult):
@@ -275,7 +275,7 @@ def moderated_noise(mod, *, hz: bool = False, ax=None):
     >>> ax.get_ylabel()
     'noise variance of the mean (dB)'
     """
-    from ..moderation import ModeratedNoise
+    from ..spectra.moderation import ModeratedNoise
     from .._validate import as_bool
 
     if not isinstance(mod, ModeratedNoise):
@@ -325,7 +325,7 @@ def disturbances(result, *, w0: float = None, hz: bool = False, fig=None):
     >>> [ax.get_title() for ax in fig.axes]
     ['input: nothing found', 'output: 1 sinusoid off the grid']
     """
-    from ..disturbances import DisturbanceResult
+    from ..spectra.disturbances import DisturbanceResult
     from .._validate import as_bool, as_float
 
     if not isinstance(result, DisturbanceResult):

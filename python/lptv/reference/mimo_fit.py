@@ -2,7 +2,7 @@
 a dense linear map of all measured lines, its covariance (19.12) and that of all rows, WGTLS
 with vector residues and A_na,0 = I, SML on the exact likelihood, the covariances and the CRB.
 
-The independent route :mod:`lptv.mimo_fit` is tested against. It shares the conventions (listed
+The independent route :mod:`lptv.estimation.mimo_fit` is tested against. It shares the conventions (listed
 here) but none of the code: the residue is e = G(xi) z with G built entry by entry for every
 row, output, line and channel; the Jacobian's column j is G(e_j) z; the noise of every row is
 G Cz G^H over the whole stacked noise vector; CJ_W is tr(W G_j' Cz G_j^H) for every pair of

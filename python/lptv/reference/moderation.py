@@ -189,7 +189,7 @@ def moderated_noise(data, half_width: int = 10) -> ModeratedNoise:
     """
     from scipy import special, stats
 
-    from ..data import FrequencyData
+    from ..spectra.frequency_data import FrequencyData
 
     if not isinstance(data, FrequencyData):
         raise ValueError(f"data must be an lptv.FrequencyData, got {type(data).__name__}")

@@ -11,7 +11,7 @@ MINPACK Levenberg-Marquardt (``least_squares(method="lm")``) where the core has 
 continuous-time grid (the signed lines -M..M, ``_CtGrid``) is one sparse matrix factorised by
 SuperLU, where the core runs its continuous-time FDS with KLU; the
 start is ``numpy.linalg.lstsq``. Nothing here calls ``lptv._core``; the local polynomial method
-(``noise="lpm"``, NumPy only, not in the core) is ``lptv.record.local_polynomial_noise``.
+(``noise="lpm"``, NumPy only, not in the core) is ``lptv.estimation.one_record.local_polynomial_noise``.
 """
 from __future__ import annotations
 
@@ -220,7 +220,7 @@ def identify_record(u, y, *, na, nb, ka, kb, w0, ts, lines=None, transient=True,
     n_eta = len(free)
 
     if isinstance(noise, str) and noise == "lpm":
-        from ..record import local_polynomial_noise        # NumPy only: not in the core
+        from ..estimation.one_record import local_polynomial_noise        # NumPy only: not in the core
         branches = kmax + 1 if lpm_branches is None else int(lpm_branches)
         var, noise_dof = local_polynomial_noise(U, Y, L, lines, branches=branches, degree=lpm_degree)
     elif isinstance(noise, str):

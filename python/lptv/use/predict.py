@@ -20,8 +20,8 @@ from typing import Optional
 import numpy as np
 
 from .._validate import as_float, as_str, check_finite, _array
-from ..mimo import MimoModel
-from ..model import Model
+from ..model.mimo import MimoModel
+from ..model.siso import Model
 
 INITIAL = ("rest", "steady")
 RTOL = 1e-10
@@ -146,8 +146,8 @@ def on_record_grid(model, L: int):
 
 
 def _steady(model, u, fs, t0):
-    from ..fds import simulate
-    from ..multisine import spectrum, time_signal
+    from ..simulation.fds import simulate
+    from ..excitation.multisine import spectrum, time_signal
 
     n = u.shape[0]
     L = whole_periods(model, n, fs)

@@ -1,7 +1,7 @@
 """A saved model against a fresh record, the model fixed (METHOD.md section 21).
 
 Periods of one input and output: the model's residues e_l = A Y - B U on the fresh record's
-lines, judged against that record's own noise by the verdict's tests (``lptv.verdict``) with
+lines, judged against that record's own noise by the verdict's tests (``lptv.judgement.verdict``) with
 the model fixed: no projection of a fit, the model's own estimation error counted instead
 (Cov r = S + J C J^T, C its covariance), and a score test per coefficient: the change of its
 parameters the fresh record asks for, against its noise and the model's covariance. Periods
@@ -20,9 +20,9 @@ import numpy as np
 
 from .. import _core
 from .._validate import _array, as_lines, check_finite
-from ..mimo import MimoModel
-from ..model import Model
-from ..verdict import ALPHA
+from ..model.mimo import MimoModel
+from ..model.siso import Model
+from ..judgement.verdict import ALPHA
 from .predict import predict, sampling, whole_periods
 
 
@@ -71,7 +71,7 @@ class ValidationResult:
     normalized_residue: np.ndarray
     """|e_l| / sqrt(var e_l) (several channels: per output, shape (rows, ny))."""
     tests: Tuple = ()
-    """The residue tests (:class:`lptv.verdict.ResidueTest`; several channels: (row, output, statistic,
+    """The residue tests (:class:`lptv.judgement.verdict.ResidueTest`; several channels: (row, output, statistic,
     p-value) as :attr:`lptv.MimoIdentificationResult.tests`; one record: the record verdict)."""
     coefficient_tests: Tuple[CoefficientTest, ...] = ()
     noise: str = "sample"
@@ -193,8 +193,8 @@ def _rows(model, max_line, lines):
 def _judged_noise(d):
     """The data the tests divide by and each line's degrees of freedom, as the verdict chooses
     (moderated when the noise spectrum is smooth, the sample (co)variances otherwise)."""
-    from .. import verdict
-    from ..moderation import moderated_noise, smooth_noise
+    from ..judgement import verdict
+    from ..spectra.moderation import moderated_noise, smooth_noise
 
     P = int(d.periods)
     if verdict.MODERATE and P >= 2:
@@ -252,9 +252,9 @@ def _parametrisation(model):
 
 
 def _siso(model, u, y, lines):
-    from ..data import FrequencyData
-    from ..validation import normalized_residue
-    from ..verdict import residue_tests
+    from ..spectra.frequency_data import FrequencyData
+    from ..judgement.validation import normalized_residue
+    from ..judgement.verdict import residue_tests
 
     d = FrequencyData.from_periods(u, y, w0=model.w0, ts=model.ts)
     rows = _rows(model, d.max_line, lines)
@@ -337,7 +337,7 @@ def _parameter_jacobian(model, U, rows, names):
     the model's inverse: a relative step of 1e-6 leaves 1e-12 of it)."""
     import re
 
-    from ..fds import simulate
+    from ..simulation.fds import simulate
 
     a, b = model.a, model.b
     out = np.empty((rows.size, model.n_outputs, len(names)), complex)
@@ -367,9 +367,9 @@ def _parameter_jacobian(model, U, rows, names):
 
 
 def _mimo(model, u, y, lines, cov=None):
-    from ..fds import htf, simulate
-    from ..mimo_data import MimoFrequencyData
-    from ..mimo_result import residue_tests
+    from ..simulation.fds import htf, simulate
+    from ..spectra.mimo_frequency_data import MimoFrequencyData
+    from ..judgement.mimo_result import residue_tests
 
     d = MimoFrequencyData.from_periods(u, y, w0=model.w0, ts=model.ts)
     rows = _rows(model, d.max_line, lines)
@@ -426,7 +426,7 @@ def _mimo(model, u, y, lines, cov=None):
 
 
 def _one_record(model, u, y, fs, lines):
-    from ..record_verdict import record_verdict
+    from ..judgement.one_record_verdict import record_verdict
 
     fs = sampling(model, fs)
     u = np.asarray(_array(u, "u"), float).reshape(-1) if np.ndim(u) != 1 else np.asarray(_array(u, "u"), float)
