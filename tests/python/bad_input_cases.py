@@ -536,6 +536,19 @@ def python_cases():
         return lp().FrequencyData(args.pop("U"), args.pop("Y"), args.pop("varU"), args.pop("varY"), **args)
 
     C += family("FrequencyData", "periods", lambda v: fd(periods=v), INT_BAD + [("one", 1, "range")])
+
+    # correlated_lines: data from periods, a probability
+    def periods_data():
+        rng = np.random.default_rng(0)
+        return lp().FrequencyData.from_periods(rng.standard_normal((4, 64)), rng.standard_normal((4, 64)), w0=1.0)
+
+    C += family("correlated_lines", "alpha", lambda v: lp().correlated_lines(periods_data(), alpha=v),
+                FLOAT_BAD + [("one", 1.0, "range")])
+    C += [Case("correlated_lines-d-none", "type", lambda: lp().correlated_lines(None), match=names("d")),
+          Case("correlated_lines-d-given", "value", lambda: lp().correlated_lines(fd(periods=4)), match=names("d")),
+          Case("FrequencyData.from_periods-statistics-bad", "value",
+               lambda: lp().FrequencyData.from_periods(np.ones((2, 8)), np.ones((2, 8)), w0=1.0, statistics="lines"),
+               match=names("statistics"))]
     C += family("FrequencyData", "w0", lambda v: fd(w0=v), FLOAT_BAD)
     C += family("FrequencyData", "ts", lambda v: fd(ts=v), [f for f in FLOAT_BAD if f[0] != "none"])
     C += [

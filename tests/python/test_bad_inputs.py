@@ -55,7 +55,7 @@ NOT_CALLED_BY_USERS = {"NumericalError", "IdentifiabilityWarning", "TruncationWa
                        "Measurements", "RecordResult", "ModeratedNoise", "Disturbance", "DisturbanceResult",
                        "LackOfFit", "Inspection", "LineClass", "MimoMultisines",
                        "MimoHtfEstimate", "MimoIdentificationResult", "MimoCramerRaoBound", "ValidationResult",
-                       "CoefficientTest"}
+                       "CoefficientTest", "LineCorrelation"}
 
 
 @pytest.mark.parametrize("name", sorted(set(lptv.__all__) - NOT_CALLED_BY_USERS))

@@ -306,10 +306,12 @@ def correlated_lines(d, alpha: float = LINES_ALPHA) -> LineCorrelation:
     >>> lptv.correlated_lines(lptv.FrequencyData.from_periods(u, y, w0=1.0)).correlated
     False
     """
-    alpha = as_float(alpha, "alpha", minimum=0.0, open_min=True)
+    alpha = as_float(alpha, "alpha", minimum=0.0, maximum=1.0, open_min=True, open_max=True,
+                     what="a probability strictly between 0 and 1")
     spectra = getattr(d, "_spectra", None)
     if spectra is None:
-        raise ValueError("d: the test reads the periods' spectra: make the data with from_periods(u, y, ...)")
+        raise ValueError(f"d must be data made by FrequencyData.from_periods(u, y, ...) (the test reads the "
+                         f"periods' spectra), got {type(d).__name__}")
     names = getattr(d, "_channel_names", ("the input", "the output"))
     return line_correlation(spectra, names, alpha)
 
