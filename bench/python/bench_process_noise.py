@@ -12,6 +12,7 @@ line test chose the record. ``--second 0.02`` adds a 2 % second harmonic to the 
 the fitted structure (ka = 1) leaves out: the rejections are then the verdict's power.
 
     python bench/python/bench_process_noise.py --runs 200 --periods 4 8 16 --loop open feedback
+    python bench/python/bench_process_noise.py --line-test --runs 200 --periods 4 8 16 --process 0 0.3 1 5
 """
 from __future__ import annotations
 
@@ -57,6 +58,33 @@ def cell(loop, P, process, runs, second, seed0):
     return out
 
 
+def line_test(args) -> int:
+    """The line test's rejections on the rig's records and on white noise (its size)."""
+    print(f"# the line test (size {lptv.spectra.frequency_data.LINES_ALPHA:g}), {args.runs} records per cell")
+    print("loop      P  dist   correlated (+-se)")
+    for loop in args.loop:
+        for P in args.periods:
+            for proc in args.process:
+                hits = 0
+                for start in range(0, args.runs, 25):
+                    seeds = [args.seed + i for i in range(start, min(args.runs, start + 25))]
+                    for rec in pr.records(seeds, periods=P, loop=loop, process=proc):
+                        d = lptv.FrequencyData.from_periods(rec["u"], rec["y"], w0=pr.W0)
+                        hits += lptv.correlated_lines(d).correlated
+                p = hits / args.runs
+                print(f"{loop:9s} {P:2d} {proc:5.1f}   {100 * p:5.1f} (+-{100 * np.sqrt(max(p * (1 - p), 1 / args.runs) / args.runs):3.1f})")
+    rng = np.random.default_rng(args.seed)
+    for P in args.periods:
+        hits = 0
+        for _ in range(args.runs):
+            u = rng.standard_normal((P, 256))
+            y = np.roll(u, 1, axis=1) + 0.3 * rng.standard_normal((P, 256))
+            hits += lptv.correlated_lines(lptv.FrequencyData.from_periods(u, y, w0=1.0)).correlated
+        p = hits / args.runs
+        print(f"white     {P:2d}    -    {100 * p:5.1f} (+-{100 * np.sqrt(max(p * (1 - p), 1 / args.runs) / args.runs):3.1f})")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=200)
@@ -66,7 +94,12 @@ def main(argv=None) -> int:
                     help="the disturbance's rms in N (0: sensor noise alone)")
     ap.add_argument("--second", type=float, default=0.0, help="a second harmonic of the stiffness left out of the fit")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--line-test", action="store_true",
+                    help="only the line test (lptv.correlated_lines): how often it finds the lines correlated, "
+                         "per loop, P and disturbance level, and on white noise")
     args = ap.parse_args(argv)
+    if args.line_test:
+        return line_test(args)
     print(f"# bench_process_noise: runs {args.runs}, second harmonic {args.second}")
     print("loop      P  dist  method route   reject (+-se)   cover  [min  max]   mean z  std z   record chosen")
     for loop in args.loop:
