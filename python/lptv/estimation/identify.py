@@ -413,6 +413,13 @@ def _record_data(d, name):
         raise ValueError(f"noise='full' takes the noise from the whole record: {name}: {e}") from None
 
 
+def _unrepeated_input(d) -> float:
+    """The power of the periods' input deviations over the power of its mean, lines 1 .. Lmax - 1
+    (P varU is a period's deviation variance)."""
+    mean = float(np.sum(np.abs(d.U[1:-1]) ** 2))
+    return float(d.periods * np.sum(d.varU[1:-1])) / mean if mean > 0 else np.inf
+
+
 def _auto_noise(datas, covariance):
     """noise='auto': ('sample', 'moderated', 'full' or 'full-moderated', the sentence saying why,
     the moderated data and their ModeratedNoise per experiment for a moderated route, else None).
@@ -436,11 +443,23 @@ def _auto_noise(datas, covariance):
     elif all(getattr(d, "_record", None) is not None for d in datas):
         tests = [correlated_lines(d) for d in datas]
         full = any(t.correlated for t in tests)
+        # the record's bins are for noise that does not repeat, not for an input that does not: a
+        # record cut at a wrong period has no line 20 dB above its periods' noise, and its refusal
+        # (with the period the record repeats at) comes from the periods' statistics
+        # the record's bins are for noise that does not repeat, not for an input that does not: in a
+        # record cut at a wrong period the periods' input differs by more than its periodic power
+        # (a closed loop's input holds a few % that does not repeat), and its refusal, with the
+        # period the record repeats at, comes from the periods' statistics
+        unrepeated = full and any(_unrepeated_input(d) > 1.0 for d in datas)
         said = [t.reason for t in tests if t.correlated == full]
         where = [i for i, t in enumerate(tests) if t.correlated == full]
         if len(datas) > 1:
             said = [f"experiment {i}: {r}" for i, r in zip(where, said)]
         lines = "; ".join(said[:3]) + (" (the noise from the whole record)" if full else "")
+        if unrepeated:
+            full = False
+            lines = ("the noise of neighbouring lines is correlated, but the input does not repeat in the periods "
+                     "(they differ by more than its periodic power): the periods' statistics")
         datas = [d.record_statistics() for d in datas] if full else datas
     sample, moderated = ("full", "full-moderated") if full else ("sample", "moderated")
 
