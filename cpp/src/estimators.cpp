@@ -309,8 +309,12 @@ class WeightedRows {
   // instead of 83 us (OpenBLAS, one thread; 59-64 us for blocks of 4-16). The same R to rounding.
   static constexpr int kQrBlock = 8;
 
-  WeightedRows(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows)
+  WeightedRows(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows, bool full = false)
       : d_(d), p_(p), rows_(rows) {
+    if (full && has_row_noise(d)) {  // the rows' noise from the realisations (METHOD.md section 20)
+      full_ = true;
+      rn_ = row_noise(d, p, rows);
+    }
     const auto by_k = detail::params_by_harmonic(p);
     size_t ne = 0;
     for (const auto& g : by_k) ne += g.size() * g.size();
@@ -352,6 +356,7 @@ class WeightedRows {
   }
 
   Eigen::VectorXd variance(const Eigen::VectorXcd& theta) const {
+    if (full_) return full_residue_variance(d_, p_, rows_, rn_, theta);
     if (!cached_) return residue_variance(d_, p_, rows_, theta);
     Eigen::VectorXcd z(static_cast<Eigen::Index>(pairs_.size()));
     for (size_t e = 0; e < pairs_.size(); ++e) z[static_cast<Eigen::Index>(e)] = std::conj(theta[pairs_[e].first]) * theta[pairs_[e].second];
@@ -387,6 +392,7 @@ class WeightedRows {
   }
 
   Eigen::MatrixXd column_covariance(const Eigen::VectorXd& w) const {
+    if (full_) return full_real_column_covariance(d_, p_, rows_, rn_, w);
     if (!cached_) return real_column_covariance(d_, p_, rows_, w);
     const Eigen::Map<const Eigen::MatrixXd> Cr(reinterpret_cast<const double*>(C_.data()), 2 * C_.rows(), C_.cols());
     const Eigen::VectorXd c = Cr * w;  // (Re, Im) of sum_l w_l C_l[e], interleaved
@@ -405,6 +411,8 @@ class WeightedRows {
   const Parametrisation& p_;
   const std::vector<int>& rows_;
   bool cached_ = false;
+  bool full_ = false;
+  RowNoise rn_;
   std::vector<std::pair<int, int>> pairs_;  // (a, b) of each entry of C_l
   std::vector<ToCj> to_cj_;
   Eigen::MatrixXd J_;   // 2m x n real Jacobian
@@ -471,7 +479,7 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
   };
   std::vector<WeightedRows> wr;
   wr.reserve(E);
-  for (size_t e = 0; e < E; ++e) wr.emplace_back(*x.d[e], p, *x.rows[e]);
+  for (size_t e = 0; e < E; ++e) wr.emplace_back(*x.d[e], p, *x.rows[e], opt.full_rows);
   std::vector<Eigen::VectorXd> w(E);
   const Eigen::MatrixXd R = stacked_r_factor(wr, p, w);
   if (opt.method == Method::LS) {
@@ -535,14 +543,31 @@ EstimateResult estimate_experiments(const Experiments& x, const Parametrisation&
     // The exact likelihood from the WGTLS estimate: WGTLS is consistent, so the start is
     // close and the Gauss-Newton steps of the refinement are short.
     ExactFit fit;
-    if (E == 1) {
-      const ExactLikelihood lik(*x.d[0], p, *x.rows[0]);
-      fit = minimise_exact_cost(lik, p, res.theta, opt.tol, opt.max_iter);
-    } else {
-      std::vector<ExactLikelihood> liks;
-      for (size_t e = 0; e < E; ++e) liks.emplace_back(*x.d[e], p, *x.rows[e], ExactLikelihood::PartOfSeveral{});
-      fit = minimise_exact_cost(liks, p, res.theta, opt.tol, opt.max_iter);
+    // The rows' noise from the realisations: S = D S_line D with D at the start, then once more
+    // at the estimate (D changes with theta to second order near the fixed point).
+    const bool scaled = opt.full_rows && std::all_of(x.d.begin(), x.d.end(), [](const FrequencyData* d) {
+      return has_row_noise(*d);
+    });
+    const int passes = scaled ? 2 : 1;
+    Eigen::VectorXcd start = res.theta;
+    int total_iter = 0;
+    for (int pass = 0; pass < passes; ++pass) {
+      if (E == 1) {
+        ExactLikelihood lik(*x.d[0], p, *x.rows[0]);
+        if (scaled) lik.set_row_scale(row_noise_scale(*x.d[0], p, *x.rows[0], start));
+        fit = minimise_exact_cost(lik, p, start, opt.tol, opt.max_iter);
+      } else {
+        std::vector<ExactLikelihood> liks;
+        for (size_t e = 0; e < E; ++e) {
+          liks.emplace_back(*x.d[e], p, *x.rows[e], ExactLikelihood::PartOfSeveral{});
+          if (scaled) liks.back().set_row_scale(row_noise_scale(*x.d[e], p, *x.rows[e], start));
+        }
+        fit = minimise_exact_cost(liks, p, start, opt.tol, opt.max_iter);
+      }
+      total_iter += fit.iterations;
+      start = fit.theta;
     }
+    fit.iterations = total_iter;
     const double scale = 1.0 / (2.0 * static_cast<double>(n_rows));
     res.theta = fit.theta;
     res.eta = p.eta_from_xi(fit.xi);

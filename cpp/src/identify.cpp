@@ -101,6 +101,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
   eo.method = opt.method;
   eo.tol = opt.tol;
   eo.max_iter = opt.max_iter;
+  eo.full_rows = opt.full_rows;
   EstimateResult er;
   if (E == 1) {
     er = estimate(*ds[0], p, rows[0], eo);
@@ -129,9 +130,14 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
   res.noise_free = er.noise_free;
 
   const Eigen::Index R = static_cast<Eigen::Index>(res.rows.size());
+  // the rows' noise from the realisations (METHOD.md section 20) where the fit took it
+  auto full = [&](size_t e) { return opt.full_rows && has_row_noise(*ds[e]); };
+  auto variance = [&](size_t e) {
+    return full(e) ? full_residue_variance(*ds[e], p, rows[e], er.theta) : residue_variance(*ds[e], p, rows[e], er.theta);
+  };
   if (E == 1) {
     res.residue = residue(*ds[0], p, rows[0], er.theta);
-    res.residue_variance = residue_variance(*ds[0], p, rows[0], er.theta);
+    res.residue_variance = variance(0);
   } else {
     res.residue.resize(R);
     res.residue_variance.resize(R);
@@ -139,7 +145,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
     for (size_t e = 0; e < E; ++e) {
       const Eigen::Index n = static_cast<Eigen::Index>(rows[e].size());
       res.residue.segment(at, n) = residue(*ds[e], p, rows[e], er.theta);
-      res.residue_variance.segment(at, n) = residue_variance(*ds[e], p, rows[e], er.theta);
+      res.residue_variance.segment(at, n) = variance(e);
       at += n;
     }
   }
@@ -245,7 +251,8 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
         const double factor = covariance_correction(P);
         Eigen::MatrixXd cov_free;
         if (E == 1) {
-          const ExactLikelihood lik(*ds[0], p, rows[0]);
+          ExactLikelihood lik(*ds[0], p, rows[0]);
+          if (full(0)) lik.set_row_scale(row_noise_scale(*ds[0], p, rows[0], er.theta));
           if (opt.method == Method::SML) {
             // The information the fit's last step computed at this very theta (the same sum).
             Eigen::MatrixXd F = er.information.size() ? er.information : lik.fisher_information(er.theta);
@@ -267,7 +274,8 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
               bread = er.information;
               break;
             }
-            const ExactLikelihood lik(*ds[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
+            ExactLikelihood lik(*ds[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
+            if (full(e)) lik.set_row_scale(row_noise_scale(*ds[e], p, rows[e], er.theta));
             if (opt.method == Method::SML) {
               const Eigen::MatrixXd F = lik.fisher_information(er.theta);
               if (e == 0) bread = F; else bread += F;
@@ -308,7 +316,8 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
         Eigen::Index at = 0;
         std::vector<int> first_order;
         for (size_t e = 0; e < E; ++e) {
-          const ExactLikelihood lik(*ds[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
+          ExactLikelihood lik(*ds[e], p, rows[e], ExactLikelihood::PartOfSeveral{});
+          if (full(e)) lik.set_row_scale(row_noise_scale(*ds[e], p, rows[e], er.theta));
           const Eigen::Index n = static_cast<Eigen::Index>(rows[e].size());
           double c = covariance_correction(periods[e]);
           if (!std::isfinite(c)) {

@@ -136,6 +136,13 @@ ExactLikelihood::Factor ExactLikelihood::factor(const Eigen::VectorXcd& theta) c
           for (int b = 0; b < 4; ++b) s += C[a][b] * en.G[c][b];
           en.H[a][c] = s;
         }
+      if (scale_.size()) {
+        const double sr = scale_[r];
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 4; ++b) en.G[a][b] *= sr;
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 2; ++b) en.H[a][b] *= sr;
+      }
       const cd v = mul(A[K_ + k], X.Y(i)) - mul(B[K_ + k], X.U(i));
       f.r[2 * r] += v.real();
       f.r[2 * r + 1] += v.imag();
@@ -329,6 +336,43 @@ Eigen::MatrixXd ExactLikelihood::real_jacobian(const FrequencyData& x) const {
   return out;
 }
 
+// With S = D S_line D (D fixed) and r = M x: dV = 2 q^T dM x - 2 (D q)^T dM Cov M^T (D q), and the
+// scaled entries give x0 = x - Cov M^T D q, so row r's part of the gradient is the Jacobian at
+// x - d_r (x - x0): (1 - d_r) J_r(x) + d_r J_r(x0) (the Jacobian is linear in the spectra).
+Eigen::MatrixXd ExactLikelihood::scaled_jacobian(const FrequencyData& x0) const {
+  Eigen::MatrixXd J = real_jacobian(x0);
+  if (!scale_.size()) return J;
+  const Eigen::MatrixXd Jx = real_jacobian(d_);
+  for (Eigen::Index r = 0; r < scale_.size(); ++r) {
+    const double s = scale_[r];
+    J.middleRows(2 * r, 2) = s * J.middleRows(2 * r, 2) + (1.0 - s) * Jx.middleRows(2 * r, 2);
+  }
+  return J;
+}
+
+void ExactLikelihood::set_row_scale(const Eigen::VectorXd& scale) {
+  if (scale.size() == 0) {
+    scale_.resize(0);
+    return;
+  }
+  if (scale.size() != static_cast<Eigen::Index>(sorted_.size()))
+    throw std::invalid_argument("scale must have one entry per row");
+  if (!scale.allFinite() || (scale.array() <= 0).any())
+    throw std::invalid_argument("scale must be finite and > 0");
+  scale_.resize(scale.size());
+  for (size_t i = 0; i < sorted_.size(); ++i) scale_[static_cast<Eigen::Index>(i)] = scale[order_[i]];
+}
+
+Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                const Eigen::VectorXcd& theta) {
+  const Eigen::VectorXd line = residue_variance(d, p, rows, theta);
+  const Eigen::VectorXd full = full_residue_variance(d, p, rows, theta);
+  Eigen::VectorXd s(line.size());
+  for (Eigen::Index r = 0; r < s.size(); ++r)
+    s[r] = (line[r] > 0 && full[r] > 0) ? std::sqrt(full[r] / line[r]) : 1.0;
+  return s;
+}
+
 ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Eigen::VectorXcd& theta) const {
   return evaluate(factor(theta), true);
 }
@@ -351,7 +395,7 @@ ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Factor& f, bool whit
       ev.denoised.Y[en.m] -= cd(z[0], z[1]);
       ev.denoised.U[en.m] -= cd(z[2], z[3]);
     }
-    ev.jacobian = real_jacobian(ev.denoised);
+    ev.jacobian = scaled_jacobian(ev.denoised);
     if (!whiten) return ev;
     forward_solve(f.Lb, kd_, ev.jacobian);
     ev.gradient = 2.0 * ev.jacobian.transpose() * ev.whitened;
@@ -371,7 +415,7 @@ ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Factor& f, bool whit
     ev.denoised.Y[m] -= cd(z[m][0], z[m][1]);
     ev.denoised.U[m] -= cd(z[m][2], z[m][3]);
   }
-  ev.jacobian = real_jacobian(ev.denoised);
+  ev.jacobian = scaled_jacobian(ev.denoised);
   if (!whiten) return ev;  // the Jacobian at x0, not whitened; no gradient
   forward_solve(f.Lb, kd_, ev.jacobian);
   ev.gradient = 2.0 * ev.jacobian.transpose() * ev.whitened;

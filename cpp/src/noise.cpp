@@ -139,6 +139,11 @@ FrequencyData frequency_data_from_record_spectra(const Eigen::Ref<const PeriodSp
   const Eigen::Index last = (N % 2 == 0) ? nl - 2 : nl - 1;
   const double rq = 1.0 / std::sqrt(double(Q));
   const int qlo = -((P + 1) / 2) + 1;  // -ceil(P/2) + 1
+  d.noise_offset.resize(Q);
+  for (int q = qlo, j = 0; q <= P / 2; ++q)
+    if (q != 0) d.noise_offset[j++] = double(q) / double(P);
+  d.noise_first = 1;
+  d.noise_last = static_cast<int>(last);
   for (Eigen::Index l = 0; l < nl; ++l) {
     if (l >= 1 && l <= last) {
       int j = 0;

@@ -66,31 +66,33 @@ void bind_estimators(py::module_& m) {
       .def_readonly("warnings", &lptv::Identification::warnings);
 
   m.def("identify", [](const lptv::FrequencyData& d, const lptv::Structure& s, const std::string& method,
-                       double tol, int max_iter, std::vector<int> rows, bool covariance) {
+                       double tol, int max_iter, std::vector<int> rows, bool covariance, bool full_rows) {
     lptv::IdentifyOptions opt;
     opt.method = lptv::method_from_string(method);
     opt.tol = tol;
     opt.max_iter = max_iter;
     opt.rows = std::move(rows);
     opt.covariance = covariance;
+    opt.full_rows = full_rows;
     py::gil_scoped_release release;  // the whole identification is C++
     return lptv::identify(d, s, opt);
   }, "data"_a, "structure"_a, "method"_a = "wgtls", "tol"_a = 1e-10, "max_iter"_a = 50,
-        "rows"_a = std::vector<int>(), "covariance"_a = true);
+        "rows"_a = std::vector<int>(), "covariance"_a = true, "full_rows"_a = false);
 
   m.def("identify_experiments", [](const std::vector<lptv::FrequencyData>& experiments, const lptv::Structure& s,
                                    const std::string& method, double tol, int max_iter,
-                                   std::vector<std::vector<int>> rows, bool covariance) {
+                                   std::vector<std::vector<int>> rows, bool covariance, bool full_rows) {
     lptv::IdentifyOptions opt;
     opt.method = lptv::method_from_string(method);
     opt.tol = tol;
     opt.max_iter = max_iter;
     opt.experiment_rows = std::move(rows);
     opt.covariance = covariance;
+    opt.full_rows = full_rows;
     py::gil_scoped_release release;  // the whole identification is C++
     return lptv::identify(experiments, s, opt);
   }, "experiments"_a, "structure"_a, "method"_a = "wgtls", "tol"_a = 1e-10, "max_iter"_a = 50,
-        "rows"_a = std::vector<std::vector<int>>(), "covariance"_a = true,
+        "rows"_a = std::vector<std::vector<int>>(), "covariance"_a = true, "full_rows"_a = false,
         R"doc(Several experiments of one system fitted into one model (lptv::identify on a list).
 
 rows: one list of rows per experiment (an empty list: that experiment's default rows), or

@@ -29,6 +29,8 @@ void bind_likelihood(py::module_& m) {
           "Cov(q - lambda CJ_W xi) over the free entries of xi: the second-order noise of WGTLS's "
           "estimating equation (METHOD.md section 10), one experiment.")
       .def("residue_covariance", &lptv::ExactLikelihood::residue_covariance, "theta"_a)
+      .def("set_row_scale", &lptv::ExactLikelihood::set_row_scale, "scale"_a,
+           "S = D S_line D with D = diag(scale), one entry per row in the caller's order (METHOD.md section 20).")
       .def_property_readonly("sorted_rows", &lptv::ExactLikelihood::sorted_rows)
       .def_property_readonly("half_bandwidth", &lptv::ExactLikelihood::half_bandwidth);
   m.def("cramer_rao_bound",

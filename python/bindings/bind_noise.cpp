@@ -1,4 +1,7 @@
 #include "lptv/noise.hpp"
+#include <stdexcept>
+#include <string>
+
 #include "pybind11.hpp"
 
 void bind_noise(py::module_& m) {
@@ -30,8 +33,26 @@ void bind_noise(py::module_& m) {
       }, "Up"_a, "Yp"_a, "Ur"_a, "Yr"_a, "n_per_period"_a,
         "The statistics from the record's bins between the lines (METHOD.md section 20): Up, Yp the "
         "periods' spectra (P, lines), Ur, Yr the rfft of the P periods concatenated / (P N).")
+      .def_static("with_realisations", [](const lptv::FrequencyData& d, const lptv::PeriodSpectra& nU,
+                                          const lptv::PeriodSpectra& nY, const lptv::FrequencyData& like) {
+        lptv::FrequencyData out = d;
+        out.noiseU = nU;
+        out.noiseY = nY;
+        out.noise_offset = like.noise_offset;
+        out.noise_first = like.noise_first;
+        out.noise_last = like.noise_last;
+        out.validate();
+        if (out.noiseU.rows() != like.noiseU.rows())
+          throw std::invalid_argument("noiseU, noiseY must have the realisations of like (" +
+                                      std::to_string(like.noiseU.rows()) + " rows)");
+        return out;
+      }, "data"_a, "noiseU"_a, "noiseY"_a, "like"_a,
+        "A copy of data with the noise realisations noiseU, noiseY on the lines and offsets of like's.")
       .def_readonly("noiseU", &lptv::FrequencyData::noiseU)
       .def_readonly("noiseY", &lptv::FrequencyData::noiseY)
+      .def_readonly("noise_offset", &lptv::FrequencyData::noise_offset)
+      .def_readonly("noise_first", &lptv::FrequencyData::noise_first)
+      .def_readonly("noise_last", &lptv::FrequencyData::noise_last)
       .def_readonly("U", &lptv::FrequencyData::U)
       .def_readonly("Y", &lptv::FrequencyData::Y)
       .def_readonly("varU", &lptv::FrequencyData::varU)

@@ -119,9 +119,13 @@ def test_the_default_keeps_the_true_structure_of_a_rig_with_a_disturbance(loop):
 
 
 def test_the_route_for_several_channels_and_one_agree():
-    """noise='full' on (P, N, 1) arrays is the one-channel fit on the record's statistics."""
+    """noise='full' on (P, N, 1) arrays is the one-channel fit on the record's per-line statistics
+    (several channels do not read the rows on the realisations yet)."""
     rec = rig.records([3], periods=8, loop="feedback", process=5.0)[0]
-    one = fit(rec, method="wgtls", noise="full")
+    d = lptv.FrequencyData.from_periods(rec["u"], rec["y"], w0=rig.W0, statistics="record")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one = lptv.identify(d, **rig.STRUCTURE, lines=rig.fit_lines(), method="wgtls", noise="sample")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         many = lptv.identify(rec["u"][:, :, None], rec["y"][:, :, None], **rig.STRUCTURE, w0=rig.W0,
@@ -152,3 +156,118 @@ def test_full_route_errors_name_what_is_wrong():
     # data given without the periods: noise='auto' stays on the given statistics
     res = lptv.identify(given, na=1, nb=0)
     assert res.noise in ("sample", "moderated")
+
+
+# -- the rows' noise from the realisations (METHOD.md section 20), the core against NumPy -------
+
+from lptv import _core  # noqa: E402
+from lptv.reference import likelihood as lk  # noqa: E402
+
+from test_likelihood_core import core_data, core_par  # noqa: E402
+from test_likelihood_reference import SEEDS, make_case, random_data, rows_of  # noqa: E402
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("domain", ["ct", "dt"])
+def test_the_row_scaled_likelihood_against_dense_sums(seed, domain):
+    """S = D S_line D (D fixed): the core's cost against r^T (D S D)^-1 r of the dense reference,
+    its gradient against central differences of that cost (the core's gradient is exact for a
+    fixed D), the residue covariance against D S D."""
+    case = make_case(seed, domain, False)
+    rng = np.random.default_rng([seed, 20])
+    d, rows = random_data(rng, case.L), [int(r) for r in rows_of(case, "default")]
+    lik = _core.ExactLikelihood(core_data(d), core_par(case), rows)
+    scale = rng.uniform(0.6, 1.4, len(rows))
+    lik.set_row_scale(scale)
+    srt = np.sort(rows)
+    Ds = np.repeat(scale[np.argsort(rows)], 2)
+
+    def ref_cost(xi):
+        th = case.par.Text @ xi
+        M = lk.residue_map(d, case.par, srt, th)
+        S = Ds[:, None] * lk.residue_covariance(d, case.par, srt, th) * Ds[None, :]
+        r = M @ lk.data_vector(d)
+        return float(r @ np.linalg.solve(S, r))
+
+    xi0 = np.linalg.lstsq(case.par.Text, case.theta, rcond=None)[0].real
+    for xi in (xi0, xi0 + 0.05 * rng.normal(size=xi0.size)):
+        th = case.par.Text @ xi
+        v = lik.cost(th)
+        assert abs(v - ref_cost(xi)) <= 1e-10 * ref_cost(xi)
+        g = np.asarray(lik.gradient(th))
+        h = 1e-6 * max(1.0, np.abs(xi).max())
+        g_fd = np.array([(ref_cost(xi + h * e) - ref_cost(xi - h * e)) / (2 * h) for e in np.eye(xi.size)])
+        # central differences: truncation h^2 |V'''| and rounding eps V / h, ~1e-7 of the gradient here
+        assert np.max(np.abs(g - g_fd)) <= 1e-5 * np.max(np.abs(g_fd))
+        S_ref = Ds[:, None] * lk.residue_covariance(d, case.par, srt, th) * Ds[None, :]
+        np.testing.assert_allclose(np.asarray(lik.residue_covariance(th)), S_ref, rtol=0,
+                                   atol=1e-11 * np.abs(S_ref).max())
+    lik.set_row_scale(np.ones(len(rows)))          # D = I is the likelihood without a scale
+    plain = _core.ExactLikelihood(core_data(d), core_par(case), rows)
+    assert lik.cost(case.theta) == pytest.approx(plain.cost(case.theta), rel=1e-14)
+    with pytest.raises(ValueError, match="scale must"):
+        lik.set_row_scale(-scale)
+
+
+def record_rows(u, y, par, rows, theta, a, b, K, w0):
+    """The rows' realisations by NumPy's FFT of the record: e_{l,q} at the bins l P + q with the
+    structure's powers at each bin's own frequency; a, b the model's (n, 2K+1) harmonic rows."""
+    P, N = u.shape
+    Ur = np.fft.fft(u.reshape(-1)) / (P * N)
+    Yr = np.fft.fft(y.reshape(-1)) / (P * N)
+    qs = [q for q in range(-((P + 1) // 2) + 1, P // 2 + 1) if q != 0]
+    out = []
+    for l in rows:
+        es = []
+        for q in qs:
+            bin_ = l * P + q
+            e = 0
+            for k in range(-K, K + 1):
+                s = 1j * w0 * (bin_ - k * P) / P
+                e += sum(a[n, K + k] * s ** n for n in range(a.shape[0])) * Yr[bin_ - k * P]
+                e -= sum(b[m, K + k] * s ** m for m in range(b.shape[0])) * Ur[bin_ - k * P]
+            es.append(e)
+        out.append(np.array(es) / np.sqrt(P - 1))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("loop", ["open", "feedback"])
+def test_the_rows_noise_from_the_realisations_against_the_record_s_bins(loop):
+    rec = rig.records([21], periods=8, loop=loop, process=5.0)[0]
+    u, y = rec["u"], rec["y"]
+    d = lptv.FrequencyData.from_periods(u, y, w0=rig.W0, statistics="record")
+    res = fit(rec, method="wgtls", noise="full")
+    K = 1
+    rows = [int(l) for l in rig.fit_lines()]
+    par = _core.Parametrisation(_core.Structure(2, 0, [1, 0, 0], [0], [], rig.W0, 0.0))
+    e = record_rows(u, y, par, rows, res.theta, *coefficient_rows(par, res.theta, K), K, rig.W0)
+    v_ref = np.sum(np.abs(e) ** 2, axis=1)
+    v = np.asarray(_core.full_residue_variance(d._cpp, par, rows, res.theta))
+    # sums of 7 squares of sums of 9 products: rounding ~1e-15 relative
+    np.testing.assert_allclose(v, v_ref, rtol=1e-12)
+    # the fit's own residue variances are these
+    np.testing.assert_allclose(res.residue_variance, v_ref, rtol=1e-12)
+    # CJ_W from the realisations: Re(T^H sum_l w_l Phi_l^H Phi_l T), whose quadratic form at any
+    # xi is the weighted noise of the rows at theta = T xi: sum_l w_l var e_l(theta); random xi
+    # (as many as CJ has entries) pin the whole symmetric matrix
+    w = 1.0 / v_ref
+    CJ = np.asarray(_core.full_real_column_covariance(d._cpp, par, rows, w))
+    assert CJ.shape == (par.n_xi, par.n_xi) and np.allclose(CJ, CJ.T, rtol=0, atol=1e-14 * np.abs(CJ).max())
+    g = np.random.default_rng(3)
+    for _ in range(par.n_xi * (par.n_xi + 1) // 2):
+        xi = g.normal(size=par.n_xi)
+        th = np.asarray(par.Text) @ xi          # theta = Text xi (no normalisation)
+        e = record_rows(u, y, par, rows, th, *coefficient_rows(par, th, K), K, rig.W0)
+        assert xi @ CJ @ xi == pytest.approx(np.sum(w * np.sum(np.abs(e) ** 2, axis=1)), rel=1e-10)
+
+
+def coefficient_rows(par, theta, K):
+    """(a, b): the (n, 2K + 1) harmonic rows of a model's coefficients from theta."""
+    m = lptv.Model._from_core(par.to_model(theta))
+    a = np.zeros((m.a.shape[0], 2 * K + 1), complex)
+    ka = m.a.shape[1] // 2
+    a[:, K - ka:K + ka + 1] = m.a
+    b = np.zeros((m.b.shape[0], 2 * K + 1), complex)
+    kb = m.b.shape[1] // 2
+    b[:, K - kb:K + kb + 1] = m.b
+    return a, b

@@ -21,6 +21,10 @@ struct EstimateOptions {
   Method method = Method::WGTLS;
   double tol = 1e-10;   // WGTLS, SML: relative change of the parameters that ends the iteration
   int max_iter = 50;    // WGTLS: cap on the weighted solves; SML: on the Levenberg-Marquardt steps
+  // The rows' noise from the data's realisations (METHOD.md section 20, has_row_noise): WGTLS's
+  // weights and CJ_W from them, SML's residue covariance with those variances on its diagonal
+  // (row_noise_scale); data without realisations keep eq. 15.
+  bool full_rows = false;
 };
 
 struct EstimateResult {
@@ -94,6 +98,7 @@ struct IdentifyOptions {
   // default_rows). With one experiment, `rows` may be used instead.
   std::vector<std::vector<int>> experiment_rows;
   bool covariance = true;   // WGTLS, SML: compute the covariance of eta
+  bool full_rows = false;   // the rows' noise from the data's realisations (EstimateOptions)
 };
 
 struct Identification {

@@ -33,6 +33,28 @@ Eigen::MatrixXcd residue_variance_gradient(const FrequencyData& d, const Paramet
 Eigen::MatrixXcd column_covariance(const FrequencyData& d, const Parametrisation& p,
                                    const std::vector<int>& rows, const Eigen::VectorXd& weights);
 
+// The rows' noise from the realisations of the lines' noise (METHOD.md section 20), when the
+// data hold them (frequency_data_from_record_spectra): each row read on every realisation q at
+// its own frequencies, the lines (l - k) + offset_q, so that var e_l(theta) = sum_q |e_{l,q}|^2
+// holds the terms between a row's lines and between input and output that eq. 15 drops. A row
+// that reads a line outside noise_first..noise_last keeps eq. 15 (full_rows[r] false).
+struct RowNoise {
+  std::vector<char> full_rows;     // per row: read on the realisations
+  std::vector<Eigen::MatrixXcd> phi;  // per full row: Q x n_theta, row q the regressor on realisation q
+};
+bool has_row_noise(const FrequencyData& d);
+RowNoise row_noise(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows);
+// var e_l of the rows: sum_q |phi_q theta|^2 on the full rows, eq. 15 on the others.
+Eigen::VectorXd full_residue_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                      const RowNoise& rn, const Eigen::VectorXcd& theta);
+Eigen::VectorXd full_residue_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                      const Eigen::VectorXcd& theta);
+// CJ_W = Re(Text^H C Text), C = sum_l w_l C_l with C_l = phi_l^H phi_l on the full rows and
+// E{dJ_l^H dJ_l} of eq. 15's noise on the others.
+Eigen::MatrixXd full_real_column_covariance(const FrequencyData& d, const Parametrisation& p,
+                                            const std::vector<int>& rows, const RowNoise& rn,
+                                            const Eigen::VectorXd& weights);
+
 // Value of s^n for line l: (j l w0)^n or exp(j l w0 ts)^n.
 cd line_power(const Structure& s, int line, int n);
 

@@ -75,6 +75,12 @@ class ExactLikelihood {
   };
   SecondOrderTerms second_order_terms(const Eigen::VectorXcd& theta, const Eigen::VectorXd& weights) const;
 
+  // The rows' noise scaled (METHOD.md section 20): S = D S_line D with D = diag(scale), one
+  // entry per row in the caller's order (empty: none), held fixed; the cost, its exact
+  // gradient for that D (the Jacobian (1 - d_r) J_r(x) + d_r J_r(x0) of row r), the Fisher
+  // information, the sandwich and the residue covariance all take it.
+  void set_row_scale(const Eigen::VectorXd& scale);
+
   // S in dense form, sorted-row order (for tests and small problems).
   Eigen::MatrixXd residue_covariance(const Eigen::VectorXcd& theta) const;
 
@@ -99,10 +105,12 @@ class ExactLikelihood {
   // With whiten = false: cost, w and x0, and the Jacobian at x0 not whitened (no gradient).
   Evaluation evaluate(const Factor& f, bool whiten) const;
   Eigen::MatrixXd real_jacobian(const FrequencyData& x) const;  // dr/dxi, sorted-row order
+  Eigen::MatrixXd scaled_jacobian(const FrequencyData& x0) const;  // with the row scale, if any
 
   FrequencyData d_;
   Parametrisation p_;
   std::vector<int> sorted_, order_;
+  Eigen::VectorXd scale_;  // sorted-row order; empty: none
   int K_ = 0, kd_ = 0;
 };
 
@@ -124,6 +132,11 @@ ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& 
 // its gradient and the Gauss-Newton information are the sums of the experiments' own.
 ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
                              const Eigen::VectorXcd& theta0, double tol, int max_iter);
+
+// sqrt(full_residue_variance / residue_variance) per row: D of ExactLikelihood::set_row_scale
+// for the rows' noise from the realisations (1 on rows that keep eq. 15).
+Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                const Eigen::VectorXcd& theta);
 
 // Cov(q - lambda CJ_W xi) over the free entries of xi (free_indices order) from the terms of
 // one experiment or their sum over independent experiments (one lambda for all):

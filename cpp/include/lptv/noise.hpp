@@ -18,6 +18,11 @@ struct FrequencyData {
   // (frequency_data_from_record_spectra); with them the rows' noise can hold the terms between
   // lines and between input and output that the per-line (co)variances drop.
   Eigen::Matrix<std::complex<double>, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> noiseU, noiseY;
+  // Realisation q lies at line l + noise_offset[q] (the record's bin l P + q, offset q / P) on
+  // the lines noise_first..noise_last; the other lines' realisations (Helmert contrasts of the
+  // periods) are not the same draws and hold no terms between lines.
+  Eigen::VectorXd noise_offset;
+  int noise_first = 0, noise_last = -1;
 
   int max_line() const { return static_cast<int>(U.size()) - 1; }
   // Throws std::invalid_argument naming the field when sizes differ, values are

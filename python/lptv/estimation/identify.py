@@ -317,11 +317,14 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
+    # the record's routes read each row on the noise's realisations (METHOD.md section 20)
+    full_rows = noise in ("full", "full-moderated")
     if several:
         rows = _experiment_rows(datas, lines, max(ka_l + kb_l))
         try:
             r = _core.identify_experiments([d._cpp for d in datas], structure, method=method, tol=float(tol),
-                                           max_iter=int(max_iter), rows=rows, covariance=analytic)
+                                           max_iter=int(max_iter), rows=rows, covariance=analytic,
+                                           full_rows=full_rows)
         except ValueError as e:
             raise ValueError(_with_distortion_hint(str(e), datas)) from None
     else:
@@ -332,7 +335,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         _below_nyquist(lines, data.max_line)
         rows = [] if lines is None else _rows(lines)
         r = _core.identify(data._cpp, structure, method=method, tol=float(tol), max_iter=int(max_iter),
-                           rows=rows, covariance=analytic)
+                           rows=rows, covariance=analytic, full_rows=full_rows)
     for msg in r.warnings:
         unident = r.nearly_unidentifiable and "unidentifiable" in msg
         warnings.warn(msg, IdentifiabilityWarning if unident else UserWarning, stacklevel=2)
@@ -496,7 +499,20 @@ def _moderated(d, mo=None):
         return d, None
     Pe = max(int(d.periods), int(round(1.0 + float(np.median(mo.dof[1:-1])) / 2.0)))
     m = mo.data
-    return FrequencyData(m.U, m.Y, m.varU, m.varY, m.covYU, w0=m.w0, ts=m.ts, periods=Pe), mo
+    out = FrequencyData(m.U, m.Y, m.varU, m.varY, m.covYU, w0=m.w0, ts=m.ts, periods=Pe)
+    if d.noise_realisations is not None:   # the record's realisations, each line's scaled to its moderated variance
+        out = out.with_realisations(*_scaled_realisations(d, m), like=d)
+    return out, mo
+
+
+def _scaled_realisations(d, m):
+    """d's noise realisations with each line's input (output) scaled by sqrt of m's variance over
+    d's, so that their sums of squares are m's variances (METHOD.md section 20)."""
+    nU, nY = d.noise_realisations
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kU = np.where(d.varU > 0, np.sqrt(m.varU / d.varU), 0.0)
+        kY = np.where(d.varY > 0, np.sqrt(m.varY / d.varY), 0.0)
+    return nU * kU, nY * kY
 
 
 def _bootstrap(r, model, structure, data, several, method, tol, max_iter, B, seed):

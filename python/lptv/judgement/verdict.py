@@ -191,20 +191,31 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
             near |= sig[np.clip(rows_e + k, 0, d.max_line)]
         keep = rows_e[near] if near.any() else rows_e
         like = _core.ExactLikelihood(d._cpp, par, [int(x) for x in keep])
+        # the record's routes: each row's variance from the noise's realisations (METHOD.md
+        # section 20), S = D S_line D with D from the data the fit weighed by
+        scale = None
+        if res.noise in ("full", "full-moderated") and _core.has_row_noise(d_fit._cpp):
+            scale = np.asarray(_core.row_noise_scale(d_fit._cpp, par, [int(x) for x in keep], theta))
+            like.set_row_scale(scale)
         srt = np.asarray(like.sorted_rows)
         pos = {int(l): int(i) for l, i in zip(lines[idx], idx)}
         order.append(np.array([pos[int(l)] for l in srt]))
         S_blocks.append(np.asarray(like.residue_covariance(theta)))
         err_blocks.append(mo.error_covariance(srt) if nu_line is not None else np.zeros((srt.size, srt.size)))
         if SML_OWN_WEIGHTS and res.method == "sml":   # SML weighs by its full residue covariance
-            Sf = S_blocks[-1] if d_fit is d else np.asarray(
-                _core.ExactLikelihood(d_fit._cpp, par, [int(x) for x in keep]).residue_covariance(theta))
+            if d_fit is d:
+                Sf = S_blocks[-1]
+            else:
+                lf = _core.ExactLikelihood(d_fit._cpp, par, [int(x) for x in keep])
+                if scale is not None:
+                    lf.set_row_scale(scale)
+                Sf = np.asarray(lf.residue_covariance(theta))
             wfit.append(np.linalg.inv(Sf))
         elif d_fit is d:
             wfit.append(np.diag(S_blocks[-1]))
         else:   # WGTLS weighs Re and Im of row l alike, by 2 / var e_l
-            wfit.append(np.repeat(np.asarray(_core.residue_variance(d_fit._cpp, par, [int(l) for l in srt],
-                                                                     theta)), 2) / 2)
+            variance = _core.full_residue_variance if scale is not None else _core.residue_variance
+            wfit.append(np.repeat(np.asarray(variance(d_fit._cpp, par, [int(l) for l in srt], theta)), 2) / 2)
         J_blocks.append(_real_jacobian(np.asarray(_core.jacobian(d._cpp, par, [int(l) for l in srt])), T, free))
         if nu_line is not None:   # a row reads lines l-K..l+K: the fewest of their dof (line 0 aside)
             nus.append(np.array([nu_line[max(l - K, 1):l + K + 1].min() for l in srt]))

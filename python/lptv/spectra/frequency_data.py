@@ -180,6 +180,17 @@ class FrequencyData:
                              "FrequencyData.from_periods(u, y, ...)")
         return FrequencyData.from_periods(rec[0], rec[1], w0=self.w0, ts=self.ts, statistics="record")
 
+    def with_realisations(self, noiseU, noiseY, *, like) -> "FrequencyData":
+        """These data with noise realisations (P - 1, lines) on the lines and offsets of ``like``'s
+        (a :class:`FrequencyData` with ``statistics='record'``); their sums of squares replace
+        nothing: the (co)variances stay these data's."""
+        cpp = _core.FrequencyData.with_realisations(self._cpp, np.ascontiguousarray(noiseU, complex),
+                                                    np.ascontiguousarray(noiseY, complex), like._cpp)
+        out = FrequencyData.__new__(FrequencyData)
+        out._set(cpp, self.w0, self.ts)
+        out.statistics = like.statistics
+        return out
+
     @property
     def noise_realisations(self):
         """(noiseU, noiseY), each (P - 1, lines): realisations of the means' noise whose sums of
