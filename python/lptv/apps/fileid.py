@@ -294,12 +294,11 @@ def run(args) -> int:
           + describe_record(meas)
           + (f", discrete-time model with ts = {args.ts:g} s" if args.ts else ", continuous-time model")
           + f") -> {out}/")
-    if meas.trimmed or meas.skipped:
-        print(f"dropped at the start: {meas.trimmed} samples (--trim), {meas.skipped} periods (--skip-periods)")
+    if dropped_note(meas):
+        print(dropped_note(meas))
     print(res.summary())
     if physical is not None:
-        print(f"parameters in physical form (--scale {scale[0]}={scale[1]:g}):")
-        print(format_parameter_table(physical).replace("(normalised)", "(by --scale)"))
+        print(units.physical_form(physical, meas)[0])
     for msg in extra:
         print(f"warning: {msg}")
     if not args.remove_disturbances and any("too small" in e for e in res.model_errors):
@@ -307,7 +306,7 @@ def run(args) -> int:
               "periodic in the record may inflate the noise estimate; --remove-disturbances finds and removes it")
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
     summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
-    summary["parameters_scaled"] = None if physical is None else parameter_table(physical)
+    summary["parameters_scaled"] = None if physical is None else units.physical_form(physical, meas)[1]
     failed = write_fit(out, res.model, summary, None if getattr(args, "no_report", False) else
                        lambda: _report(src, meas, res, Y_pred, summary, known=known))
     return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)

@@ -48,10 +48,38 @@ def verdict_status(res) -> int:
 
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``prog: error: message`` on stderr, exit status 2 (the usage
-    block stays in ``--help``)."""
+    block stays in ``--help``). A command's namespace also holds ``given_options``, the
+    destinations of the options given on the command line (even at their default value), so that
+    a route can refuse an option it would otherwise ignore (:func:`refuse_given`)."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {' '.join(str(message).split())}\n")
+
+    def parse_known_args(self, args=None, namespace=None):
+        ns, rest = super().parse_known_args(args, namespace)
+        if self._subparsers is None and args is not None:
+            # the same words once more with every default suppressed: what remains was given
+            saved = [(a, a.default) for a in self._actions if a.option_strings]
+            try:
+                for a, _ in saved:
+                    a.default = argparse.SUPPRESS
+                given = vars(super().parse_known_args(list(args), None)[0])
+            except SystemExit:        # the first parse accepted these words: not reached
+                given = {}
+            finally:
+                for a, d in saved:
+                    a.default = d
+            ns.given_options = frozenset(given)
+        return ns, rest
+
+
+def refuse_given(args, refused: dict, route: str):
+    """A FileError for the first option of ``refused`` ({dest: reason}) given on the command line
+    (:class:`Parser`'s ``given_options``): ``--method: --one-record ... (reason)``."""
+    given = getattr(args, "given_options", frozenset())
+    for dest, reason in refused.items():
+        if dest in given:
+            raise FileError(f"--{dest.replace('_', '-')} is not for {route}: {reason}")
 
 
 def integer(value, opt, minimum=0, maximum=INT_MAX):
