@@ -284,8 +284,10 @@ def run(args) -> int:
                 e = cause
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
+    transient = inspectrec.transient_note(diag, meas.u.shape[-1], meas.skipped, res.model_ok)
     extra = ([f"{checked} (kept by --no-period-check)"] if checked else []) \
-        + ([output_note] if output_note else []) + list(record.messages) \
+        + ([output_note] if output_note else []) + ([transient] if transient else []) \
+        + [m for m in record.messages if not (transient and "transient" in m)] \
         + [str(w.message) for w in caught if str(w.message) not in res.warnings]
 
     P, N = meas.u.shape
