@@ -1191,9 +1191,11 @@ def cli_cases():
             argv = list(sel)
             argv[argv.index(opt) + 1] = v
             add(f"select-{opt[2:]}-{v}", argv, opt)
-    for opt in ("--w0", "--period", "--ts"):
+    for opt in ("--w0", "--period", "--ts", "--fs", "--dt"):
         for v in ("nan", "-1", "abc"):
             add(f"select-{opt[2:]}-{v}", sel + (opt, v), opt)
+    for v in ("-1", "abc", "3") + big:
+        add(f"select-skip-periods-{v}", sel + ("--skip-periods", v), "--skip-periods")
     for v in ("-1", "abc", "2147483648"):
         add(f"select-refine-{v}", sel + ("--refine", v), "--refine")
     add("select-periods-0", sel + ("--periods", "0"), "--periods")

@@ -240,3 +240,29 @@ def test_select_reads_the_named_channels_and_the_time_column(record, tmp_path, c
     assert f"{P} periods of {N} samples" in out
     ref = lptv.identify(*record, na=1, nb=0, w0=W0)
     assert_same_model(tmp_path / "s" / "model.json", ref)
+
+
+def test_the_physical_form_carries_units_in_the_terminal_and_summary(tmp_path, capsys):
+    """Guide page 05: --scale b0=1 gives the parameters in the channels' units (force [N],
+    displacement [m]) in the terminal and in summary.json's parameters_scaled."""
+    u, y = _steady_rig()
+    src = rig_csv(tmp_path / "rig.csv", u, y, header="time [s],force [N],displacement [m]")
+    rc, out, err = identify_cli(capsys, src, "--input", "force", "--output", "displacement", "--period", T0,
+                                "--na", "2", "--nb", "0", "--scale", "b0=1", "--no-report", "--out", tmp_path / "o")
+    assert rc == 0, err
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    units = {r["name"]: r["unit"] for r in summary["parameters_scaled"]}
+    assert (units["a0.re0"], units["a1.re0"], units["a2.re0"]) == ("N/m", "N s/m", "N s^2/m")
+    table = out[out.index("parameters in physical form"):]
+    for name, unit in (("a0.re0", "N/m"), ("a1.re0", "N s/m"), ("a2.re0", "N s^2/m")):
+        assert next(x for x in table.splitlines() if x.split()[:1] == [name]).endswith(unit), name
+
+
+def _steady_rig():
+    """m x'' + c x' + k x = F (m = 2, c = 3, k = 40) by solve_ivp from rest (outside_records.py); the
+    last 4 of 12 periods (the transient, exp(-0.75 t), long gone), 1 % noise."""
+    from outside_records import mass_spring_damper, odd_lines
+
+    _, f, x = mass_spring_damper(T0, FS, 12, lines=odd_lines(1, 10, seed=3), noise=0.01, seed=5, variation=0.0,
+                                 mass=2.0, damping=3.0, stiffness=40.0)
+    return f[-P * N:].reshape(P, N), x[-P * N:].reshape(P, N)

@@ -223,3 +223,41 @@ def test_four_periods_of_a_continuous_record_find_the_missing_harmonic(seed):
     assert right.model_ok, right.verdict
     assert not lti.model_ok
     assert any("harmonic 1 of a0" in e for e in lti.model_errors), lti.verdict
+
+
+def test_the_command_line_route_honours_or_refuses_every_option(tmp_path, capsys):
+    """--scale and --skip-periods are honoured; --known, --method, --noise, --periods, --tol ... are
+    refused with the reason (exit 2), never ignored; the parameters are shown to the digits of
+    their std, with units, and the report's advice to read them physically is the right way round."""
+    import json
+
+    from lptv.apps import cli
+
+    src = _rig_csv(tmp_path / "rig.csv")
+    base = ["identify", str(src), "--one-record", "--input", "force", "--output", "displacement", "--period", "10",
+            "--na", "2", "--nb", "0", "--ka", "1,0,0", "--kb", "0"]
+    for opt, value in (("--known", "b0=1"), ("--method", "sml"), ("--method", "wgtls"), ("--noise", "sample"),
+                       ("--periods", "8"), ("--tol", "1e-8"), ("--covariance", "bootstrap")):
+        assert cli.main(base + [opt, value, "--out", str(tmp_path / "x")]) == 2, opt
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{opt} is not for --one-record: " in err, err
+    # --scale b0=2: the parameters in physical form, with units (x'' + 0.4 x' + 4 (1 + 0.1 cos) x = f, m = 1)
+    assert cli.main(base + ["--scale", "b0=2", "--out", str(tmp_path / "s")]) == 0
+    out = capsys.readouterr().out
+    summary = json.loads((tmp_path / "s" / "summary.json").read_text())
+    scaled = {r["name"]: r for r in summary["parameters_scaled"]}
+    assert scaled["a2.re0"]["value"] == pytest.approx(2.0, abs=4 * scaled["a2.re0"]["std"])
+    assert scaled["a1.re0"]["value"] == pytest.approx(0.8, abs=4 * scaled["a1.re0"]["std"])
+    assert (scaled["a2.re0"]["unit"], scaled["a1.re0"]["unit"], scaled["a0.re0"]["unit"]) == ("N s^2/m", "N s/m", "N/m")
+    assert summary["parameters"]["a0.re0"]["unit"] == "1/s^2"
+    assert "parameters in physical form (--scale b0=2)" in out
+    # a0.re0 = 4 with a std of a few 1e-4: printed to the std's digits, never as a bare "4"
+    a0 = summary["parameters"]["a0.re0"]
+    line = next(x for x in out.splitlines() if x.split()[:1] == ["a0.re0"])
+    decimals = len(line.split()[1].split(".")[1])
+    assert 10.0 ** -decimals <= a0["std"] and "1/s^2" in line, line
+    # --skip-periods drops whole periods before the fit
+    assert cli.main(base + ["--skip-periods", "2", "--no-report", "--out", str(tmp_path / "k")]) == 0
+    assert "one record of 6 periods of 128 samples" in capsys.readouterr().out
+    html = (tmp_path / "s" / "report.html").read_text()
+    assert "multiply every coefficient by the mean of a_na" in html and "divide every coefficient by the one" not in html

@@ -27,15 +27,15 @@ def lti_measurements(seed, periods=8):
 
 
 def check_ranking(sel):
-    """Residue-test passes first, SML before WGTLS, then the criterion ascending; never a rejected choice
+    """The verdict's passes first, SML before WGTLS, then the criterion ascending; never a rejected choice
     while another candidate passes."""
-    keys = [(r["error"] != "", not r["residue_ok"], r["method"] != "sml", r[sel.criterion]) for r in sel.rows]
+    keys = [(r["error"] != "", not r["model_ok"], r["method"] != "sml", r[sel.criterion]) for r in sel.rows]
     assert keys == sorted(keys)
     assert [r["rank"] for r in sel.rows] == list(range(1, len(sel.rows) + 1))
     top = sel.rows[0]
     assert (top["na"], top["nb"], top["k"]) == sel.choice
-    if any(r["residue_ok"] for r in sel.rows):
-        assert top["residue_ok"] and sel.choice_ok and sel.result.residue_ok
+    if any(r["model_ok"] for r in sel.rows):
+        assert top["model_ok"] and sel.choice_ok and sel.result.model_ok
     assert sel.result.model.na == sel.choice[0] and sel.result.model.nb == sel.choice[1]
     assert np.array_equal(sel.result.lines, sel.lines)
 
@@ -97,10 +97,10 @@ def test_aic_ranking_and_sml_rows_carry_the_exact_cost():
 
 def test_every_candidate_rejected_is_said_clearly():
     m = paper_measurements(seed=1, periods=8)
-    with pytest.warns(UserWarning, match="EVERY candidate fails the residue test"):
+    with pytest.warns(UserWarning, match="the verdict rejects EVERY candidate"):
         sel = lptv.select(m["u"], m["y"], w0=m["w0"], na=[1], nb=[0], k=[0, 1], lines=LINES,
                           executor="serial", progress=False)
-    assert not sel.choice_ok and not any(r["residue_ok"] for r in sel.rows)
+    assert not sel.choice_ok and not any(r["model_ok"] for r in sel.rows)
     assert "EVERY candidate" in sel.summary()
     check_ranking(sel)
 
@@ -194,3 +194,63 @@ def test_readme_select_example_runs():
     ns = {}
     exec(compile(blocks[0], "06-structure.md", "exec"), ns)
     assert ns["sel"].choice == (2, 1, 3) and ns["sel"].result.method == "sml"
+
+
+# ------------------------------------------------------------------------------ a rig's record from rest
+
+def _rig_from_rest(path):
+    """m x'' + c x' + k(t) x = F from rest by solve_ivp (outside_records.py): 10 periods of 4 s at
+    50 Hz, a transient decaying as exp(-0.27 t) (c = 0.54), 20 odd lines, 1 % noise."""
+    from outside_records import mass_spring_damper, odd_lines
+
+    t, f, x = mass_spring_damper(4.0, 50.0, 10, lines=odd_lines(1, 20, seed=7), noise=0.01, seed=0, damping=0.54)
+    np.savetxt(path, np.column_stack([t, f, x]), fmt="%.17g", delimiter=",",
+               header="time [s],force [N],displacement [m]", comments="")
+    return f.reshape(10, -1), x.reshape(10, -1)
+
+
+def test_cli_select_takes_the_record_options_of_identify_and_each_candidate_s_verdict(tmp_path, capsys):
+    import csv
+    import json
+
+    from lptv.apps.cli import main
+
+    src = tmp_path / "rig.csv"
+    u, y = _rig_from_rest(src)
+    out = tmp_path / "sel"
+    rc = main(["select", str(src), "--input", "force", "--output", "displacement", "--period", "4",
+               "--skip-periods", "6", "--lines", "excited", "--na", "2", "--nb", "0-1", "--k", "0-1",
+               "--workers", "1", "--out", str(out)])
+    text, err = capsys.readouterr()
+    assert rc == 0, err
+    assert "4 periods of 200 samples" in text and "dropped at the start: 6 periods (--skip-periods)" in text
+    assert "choice (MDL): na = 2, nb = 0, k = 1" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["skipped_periods"] == 6 and summary["choice"] == {"na": 2, "nb": 0, "k": 1}
+    rows = list(csv.DictReader((out / "selection.csv").open()))
+    # every candidate's verdict is lptv.identify's on the same periods and rows (the excited lines +-1)
+    from lptv.estimation.identify import excited_rows
+
+    data = lptv.FrequencyData.from_periods(u[6:], y[6:], w0=2 * np.pi / 4)
+    assert summary["n_lines"] == excited_rows(data, 1).size
+    for r in rows:
+        na, nb, k = int(r["na"]), int(r["nb"]), int(r["k"])
+        res = lptv.identify(data, na=na, nb=nb, ka=k, kb=k, lines=excited_rows(data, 1), method=r["method"],
+                            covariance="none")
+        assert (r["model_ok"] == "True") == res.model_ok, (r, res.verdict)
+        assert r["verdict"] == ("consistent" if res.model_ok and res.undetermined is None else
+                                "MODEL ERRORS" if not res.model_ok else "NOT DETERMINED")
+    lti = [r for r in rows if r["k"] == "0"]
+    assert lti and all(r["verdict"] == "MODEL ERRORS" for r in lti)       # never "ok"
+    assert all(" ok" not in line for line in text.splitlines() if line.split()[3:4] == ["0"])
+
+
+def test_select_takes_lines_excited():
+    u, y = lti_measurements(1, periods=4)
+    sel = lptv.select(u, y, w0=0.04, na=[2], nb=[1], k=[0, 1], lines="excited", executor="serial", progress=False)
+    from lptv.estimation.identify import excited_rows
+
+    rows = excited_rows(lptv.FrequencyData.from_periods(u, y, w0=0.04), 1)
+    assert np.array_equal(sel.lines, rows) and np.array_equal(sel.result.lines, rows)
+    with pytest.raises(ValueError, match="lines must be a sequence of integers or 'excited'"):
+        lptv.select(u, y, w0=0.04, na=[2], nb=[1], k=[0], lines="all", executor="serial", progress=False)

@@ -111,8 +111,10 @@ def test_transient_in_the_first_period_warns_and_skip_periods_cures_it(tmp_path,
     assert lptv.check_record(u0, y0, warn=False).ok  # steady state: no false alarm
     src = write_csv(tmp_path / "t.csv", u.ravel(), y.ravel())
     rc, out, err = run_cli(capsys, src, "--na", 2, "--nb", 0, "--fs", FS, "--period", T0, "--out", tmp_path / "o")
-    # the transient left in: warned, and the verdict rejects the fit it spoils (exit status 3)
-    assert rc == 3 and "warning: the first period differs" in out and "verdict: MODEL ERRORS" in out
+    # the transient left in: warned (what lptv inspect counts to drop, in place of the first period's
+    # check), and the verdict rejects the fit it spoils (exit status 3)
+    assert rc == 3 and "warning: the verdict sees the start-up transient" in out and "verdict: MODEL ERRORS" in out
+    assert "--skip-periods 2 drops it" in out and "first period differs" not in out
     rc, out, err = run_cli(capsys, src, "--na", 2, "--nb", 0, "--fs", FS, "--period", T0, "--skip-periods", 1,
                            "--out", tmp_path / "o")
     assert rc == 0 and "first period differs" not in out and "7 periods of 1000" in out

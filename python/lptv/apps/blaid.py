@@ -147,10 +147,9 @@ def run(args, src, meas, *, w0, ts, lines, ka, kb, known) -> int:
     except ValueError as e:
         return _fail(src, e)
     if physical is not None:
-        print(f"parameters in physical form (--scale {scale[0]}={scale[1]:g}):")
-        print(format_parameter_table(physical).replace("(normalised)", "(by --scale)"))
+        print(units.physical_form(physical, meas)[0])
     summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
-    summary["parameters_scaled"] = None if physical is None else parameter_table(physical)
+    summary["parameters_scaled"] = None if physical is None else units.physical_form(physical, meas)[1]
     failed = write_fit(out, res.model, summary, None if getattr(args, "no_report", False) else
                        lambda: _report(src, meas, dist, res, summary, known=known))
     return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)

@@ -5,7 +5,7 @@ Fits every structure of the grid ``--na`` x ``--nb`` x ``--k`` (ranges like ``1-
 prints the ranking and the choice, and writes into ``--out`` (default ``<file stem>-select/``):
 ``selection.csv`` (the ranked table), ``model.json`` (the chosen structure's fit) and
 ``summary.json``. The file formats and the period options are those of ``lptv identify``.
-Exit status 0 with a choice the residue test accepts, 1 when every candidate is rejected (the
+Exit status 0 with a choice the verdict accepts, 1 when every candidate is rejected (the
 least bad is still written), 2 for bad options or files.
 
 Example (the paper's simulation example as a measurement file)::
@@ -23,12 +23,10 @@ import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
-
-from lptv import read_measurements, select
+from lptv import select
 from lptv.atomic import atomic_open
-from lptv.apps.options import parse_lines, positive
-from lptv.apps.options import bounded_range, in_option_terms, integer, output_folder
+from lptv.apps.options import add_record_options, fundamental, parse_lines, read_record, sample_period
+from lptv.apps.options import bounded_range, describe_record, dropped_note, in_option_terms, integer, output_folder
 from lptv.apps.manyid import executor_of
 from lptv.apps.report import write_json
 from lptv.records.measurements import FileError
@@ -37,7 +35,8 @@ from lptv.records.measurements import FileError
 GRID_MAX = 10_000
 """The most values one grid option may hold (every combination is a fit)."""
 OPTION_NAMES = {"na": "--na", "nb": "--nb", "k": "--k", "refine": "--refine", "lines": "--lines",
-                "criterion": "--criterion", "w0": "--w0", "ts": "--ts", "workers": "--workers"}
+                "criterion": "--criterion", "w0": "--w0", "ts": "--ts", "workers": "--workers",
+                "periods": "--periods", "skip_periods": "--skip-periods", "fs": "--fs", "dt": "--dt"}
 
 
 def parse_grid(text, opt):
@@ -57,9 +56,9 @@ def add_parser(sub):
     p = sub.add_parser(
         "select", help="choose the orders and harmonic count of a model from a measurement file",
         description="Fits a grid of structures (na, nb, k harmonics on every coefficient) by WGTLS, "
-                    "the best per k again by SML, ranks them by MDL (or AIC) with the residue test "
+                    "the best per k again by SML, ranks them by MDL (or AIC) with the verdict "
                     "first, and writes the ranking (selection.csv), the chosen model.json and "
-                    "summary.json into --out; exit status 1 when every candidate fails the residue test.",
+                    "summary.json into --out; exit status 1 when the verdict rejects every candidate.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="examples:\n"
                "  lptv select meas.npz --na 1-3 --nb 0-2 --k 0-4\n"
@@ -69,16 +68,7 @@ def add_parser(sub):
     p.add_argument("--na", default="1-3", help="orders of the output side to try (default 1-3)")
     p.add_argument("--nb", default="0-2", help="orders of the input side to try (default 0-2)")
     p.add_argument("--k", help="harmonic counts to try, e.g. 0-4 (default: from the data's HTF branches)")
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--w0", type=float, help="fundamental of the period (rad/s)")
-    g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
-    p.add_argument("--ts", type=float, help="sample period: discrete-time models")
-    p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
-    p.add_argument("--input", metavar="NAME", help="the input channel (column, array or variable; default u)")
-    p.add_argument("--output", metavar="NAME", help="the output channel (default y; one at a time)")
-    p.add_argument("--time", metavar="NAME",
-                   help="a time column or variable giving fs (default: one named t or time), as for lptv identify")
-    p.add_argument("--lines", help="rows of every fit, e.g. 1-243 (default: those of the largest k)")
+    add_record_options(p)
     p.add_argument("--criterion", default="mdl", choices=["mdl", "aic"], help="ranking criterion (default mdl)")
     p.add_argument("--refine", type=int, default=2, metavar="N",
                    help="structures per harmonic count refitted by SML (default 2; 0: WGTLS only)")
@@ -95,23 +85,6 @@ def _error(problem) -> int:
     return 2
 
 
-def _w0(args, meas):
-    w0 = positive(args.w0, "--w0")
-    if positive(args.period, "--period") is not None:
-        w0 = 2 * np.pi / args.period
-    if meas.w0 is not None:
-        if w0 is not None and not np.isclose(w0, meas.w0, rtol=1e-9, atol=0):
-            raise FileError(f"the options give w0 = {w0:.10g} rad/s but the file says w0 = {meas.w0:.10g}")
-        w0 = meas.w0
-    if positive(args.ts, "--ts") is not None and w0 is None:
-        w0 = 2 * np.pi / (meas.u.shape[1] * args.ts)
-    if w0 is None and meas.fs is not None:
-        w0 = 2 * np.pi * meas.fs / meas.u.shape[1]     # the file's own fs: the period is N / fs
-    if w0 is None:
-        raise FileError("the period is unknown: give --w0 (rad/s) or --period (s)")
-    return float(w0)
-
-
 def run(args) -> int:
     src = args.file
     try:
@@ -126,14 +99,12 @@ def run(args) -> int:
         except OSError as e:
             raise FileError(f"{e.filename or args.out}: {e.strerror or e}") from None
         executor, workers = executor_of(args)
-        period = positive(args.period, "--period")
-        if period is None and positive(args.w0, "--w0") is not None:
-            period = 2 * np.pi / args.w0
-        meas = read_measurements(src, args.periods, period=period, u=args.input, y=args.output, time=args.time)
-        w0 = _w0(args, meas)
+        meas = read_record(src, args)
+        ts = sample_period(args, meas)
+        w0 = fundamental(args, meas)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")      # the result says the same in its warnings
-            sel = select(meas.u, meas.y, w0=w0, ts=args.ts, na=na, nb=nb, k=k, lines=lines,
+            sel = select(meas.u, meas.y, w0=w0, ts=ts, na=na, nb=nb, k=k, lines=lines,
                          criterion=args.criterion, refine=args.refine, executor=executor, workers=workers)
     except FileError as e:
         return _error(f"{src}: {e}")
@@ -141,8 +112,11 @@ def run(args) -> int:
         return _error(e)
     out = Path(args.out) if args.out else Path(Path(src).stem + "-select")
     P, N = meas.u.shape
-    print(f"lptv select: {src} ({meas.format}, {P} periods of {N} samples, w0 = {w0:.6g} rad/s), "
+    print(f"lptv select: {src} ({meas.format}, {P} periods of {N} samples, w0 = {w0:.6g} rad/s"
+          + describe_record(meas) + (f", discrete-time models with ts = {ts:g} s" if ts else "") + "), "
           f"{len(sel.rows)} structures on {sel.lines.size} lines, {sel.executor}, {sel.elapsed:.1f} s -> {out}/")
+    if dropped_note(meas):
+        print(dropped_note(meas))
     print(sel.summary())
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -152,7 +126,9 @@ def run(args) -> int:
             w.writerows(sel.rows)
         sel.result.model.save(out / "model.json")
         write_json(out / "summary.json", {
-            "file": str(src), "periods": P, "samples_per_period": N, "w0": w0, "ts": args.ts,
+            "file": str(src), "periods": P, "samples_per_period": N, "w0": w0, "ts": ts,
+            "fs": meas.fs, "input": meas.input, "output": meas.output, "trimmed_samples": meas.trimmed,
+            "skipped_periods": meas.skipped,
             "criterion": sel.criterion, "choice": dict(zip(("na", "nb", "k"), sel.choice)),
             "choice_ok": sel.choice_ok, "method": sel.result.method, "n_lines": int(sel.lines.size),
             "correction": sel.correction, "htf_harmonics": sel.htf_harmonics,

@@ -50,7 +50,7 @@ from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_ze
                   parameter_table, plots, simulate)
 from lptv.apps.options import (OPTION_NAMES, describe_record, fundamental, in_option_terms, integer,  # noqa: F401
                                output_folder, parse_counts, parse_known, parse_lines, positive, read_options,
-                               read_record)
+                               read_record, add_record_options, sample_period, dropped_note)
 from lptv.apps import inspectrec
 from lptv.apps.options import verdict_status
 from lptv.apps import units
@@ -103,14 +103,7 @@ def add_parser(sub):
     p.add_argument("--nb", type=int, required=True, help="order of the input side")
     p.add_argument("--ka", default="0", help="harmonics of every a_n, or a comma list one per a_n (default 0)")
     p.add_argument("--kb", default="0", help="harmonics of every b_m, or a comma list one per b_m (default 0)")
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--w0", type=float, help="fundamental of the period (rad/s)")
-    g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
-    s = p.add_mutually_exclusive_group()
-    s.add_argument("--fs", type=float, metavar="HZ",
-                   help="sampling frequency of the record (Hz); the model stays continuous-time. With the "
-                        "period it gives the samples per period and splits a long record into whole periods")
-    s.add_argument("--dt", type=float, metavar="S", help="sampling time of the record (s), 1 / fs")
+    add_record_options(p, several=True)
     p.add_argument("--one-record", action="store_true",
                    help="the file is one record that does not repeat (a start-up transient, an input that is "
                    "not periodic): fit it whole with its transient (lptv.identify_record); needs --period "
@@ -118,30 +111,6 @@ def add_parser(sub):
     p.add_argument("--input-noise", type=float, metavar="STD",
                    help="with --one-record: the std of the input's measurement noise, when known; its bias "
                    "is measured and removed (the corrected parameters are printed and saved)")
-    p.add_argument("--discrete", action="store_true",
-                   help="identify a discrete-time model (in the shift z) with the sample period 1 / fs")
-    p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "
-                   "to state how the record was sampled for a continuous-time model use --fs or --dt")
-    p.add_argument("--input", metavar="NAME",
-                   help="the input channel: a CSV column, NPZ array or MAT variable (default u); several as a "
-                        "comma list")
-    p.add_argument("--output", metavar="NAME",
-                   help="the output channel (default y); several as a comma list (--input f1,f2 --output x1,x2): "
-                        "the files are then experiments of one system of several inputs and outputs")
-    p.add_argument("--time", metavar="NAME",
-                   help="a time column or variable (s) giving fs, checked uniform (default: one named t or "
-                        "time); without --fs, --dt and --periods the file's time or stored fs / dt / Ts is used")
-    p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
-    p.add_argument("--trim", action="store_true",
-                   help="with --fs: drop the first samples of a long record to keep whole periods")
-    p.add_argument("--skip-periods", type=int, default=0, metavar="K",
-                   help="drop the first K periods (a start-up transient)")
-    p.add_argument("--detrend", action="store_true",
-                   help="take a linear drift out of each channel (the trend across the periods; each "
-                   "period's shape is kept)")
-    p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150, or 'excited' (the lines "
-                   "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
-                   "judges every row that reads a line with signal")
     p.add_argument("--method", default="wgtls", choices=METHODS, help="estimator (default wgtls)")
     p.add_argument("--covariance", default="analytic", choices=("analytic", "bootstrap", "realisations"),
                    help="WGTLS/SML parameter covariance: the analytic sandwich (default), a parametric "
@@ -278,13 +247,7 @@ def run(args) -> int:
         if checked and not args.no_period_check:
             raise FileError(f"{checked} (--no-period-check fits the record as cut anyway)")
         output_note = inspectrec.output_period_note(diag, meas.u.shape[-1])
-        if args.discrete and args.ts is not None:
-            raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
-        if args.discrete and meas.fs is None:
-            raise FileError("--discrete needs the sampling frequency --fs (or --dt)")
-        ts = 1.0 / meas.fs if args.discrete else args.ts
-        if args.discrete:
-            args.ts = ts
+        ts = sample_period(args, meas)
         w0 = fundamental(args, meas)
         if meas.realisations and args.remove_disturbances:
             raise FileError("--remove-disturbances takes a record of periods of one realisation, not M x P x N "
@@ -321,8 +284,10 @@ def run(args) -> int:
                 e = cause
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
+    transient = inspectrec.transient_note(diag, meas.u.shape[-1], meas.skipped, res.model_ok)
     extra = ([f"{checked} (kept by --no-period-check)"] if checked else []) \
-        + ([output_note] if output_note else []) + list(record.messages) \
+        + ([output_note] if output_note else []) + ([transient] if transient else []) \
+        + [m for m in record.messages if not (transient and "transient" in m)] \
         + [str(w.message) for w in caught if str(w.message) not in res.warnings]
 
     P, N = meas.u.shape
@@ -331,12 +296,11 @@ def run(args) -> int:
           + describe_record(meas)
           + (f", discrete-time model with ts = {args.ts:g} s" if args.ts else ", continuous-time model")
           + f") -> {out}/")
-    if meas.trimmed or meas.skipped:
-        print(f"dropped at the start: {meas.trimmed} samples (--trim), {meas.skipped} periods (--skip-periods)")
+    if dropped_note(meas):
+        print(dropped_note(meas))
     print(res.summary())
     if physical is not None:
-        print(f"parameters in physical form (--scale {scale[0]}={scale[1]:g}):")
-        print(format_parameter_table(physical).replace("(normalised)", "(by --scale)"))
+        print(units.physical_form(physical, meas)[0])
     for msg in extra:
         print(f"warning: {msg}")
     if not args.remove_disturbances and any("too small" in e for e in res.model_errors):
@@ -344,7 +308,7 @@ def run(args) -> int:
               "periodic in the record may inflate the noise estimate; --remove-disturbances finds and removes it")
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
     summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
-    summary["parameters_scaled"] = None if physical is None else parameter_table(physical)
+    summary["parameters_scaled"] = None if physical is None else units.physical_form(physical, meas)[1]
     failed = write_fit(out, res.model, summary, None if getattr(args, "no_report", False) else
                        lambda: _report(src, meas, res, Y_pred, summary, known=known))
     return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)

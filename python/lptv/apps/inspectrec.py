@@ -173,6 +173,24 @@ def setup_problem(insp, args, samples_per_period=None):
     return wrong_period(insp, args, samples_per_period)
 
 
+def transient_note(insp, samples_per_period, skipped: int, model_ok: bool):
+    """What ``lptv identify`` says when the periods it fits still hold the start-up transient that
+    :func:`lptv.inspect` finds (``insp.transient_periods`` more than the ``skipped`` ones): a
+    rejection is then the transient's (its spectrum is smooth and lies on every line, the rows
+    next to the excited lines too), a pass still biased. None when no transient is left."""
+    if insp is None or not insp.repeats or insp.period_samples != samples_per_period \
+            or insp.transient_periods <= skipped:
+        return None
+    K = insp.transient_periods
+    kept = f"with {skipped} dropped, " if skipped else ""
+    if model_ok:
+        return (f"the record's first {K} periods hold a start-up transient (lptv inspect): {kept}what is left "
+                f"of it biases the parameters though the verdict finds no error; --skip-periods {K} drops it")
+    return (f"the verdict sees the start-up transient: the record's first {K} periods hold one (lptv inspect), "
+            f"{kept}left in the fitted periods it lies on every line, the rows next to the excited lines too; "
+            f"--skip-periods {K} drops it")
+
+
 def not_repeating(insp) -> str:
     return (f"the record does not repeat at any period up to {insp.seconds(insp.max_period_samples, 'half the record')}"
             f": the input's best lag leaves {100 * min(insp.repeat_ratio, 9.99):.3g} % of its power unexplained; it "

@@ -48,10 +48,38 @@ def verdict_status(res) -> int:
 
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``prog: error: message`` on stderr, exit status 2 (the usage
-    block stays in ``--help``)."""
+    block stays in ``--help``). A command's namespace also holds ``given_options``, the
+    destinations of the options given on the command line (even at their default value), so that
+    a route can refuse an option it would otherwise ignore (:func:`refuse_given`)."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {' '.join(str(message).split())}\n")
+
+    def parse_known_args(self, args=None, namespace=None):
+        ns, rest = super().parse_known_args(args, namespace)
+        if self._subparsers is None and args is not None:
+            # the same words once more with every default suppressed: what remains was given
+            saved = [(a, a.default) for a in self._actions if a.option_strings]
+            try:
+                for a, _ in saved:
+                    a.default = argparse.SUPPRESS
+                given = vars(super().parse_known_args(list(args), None)[0])
+            except SystemExit:        # the first parse accepted these words: not reached
+                given = {}
+            finally:
+                for a, d in saved:
+                    a.default = d
+            ns.given_options = frozenset(given)
+        return ns, rest
+
+
+def refuse_given(args, refused: dict, route: str):
+    """A FileError for the first option of ``refused`` ({dest: reason}) given on the command line
+    (:class:`Parser`'s ``given_options``): ``--method: --one-record ... (reason)``."""
+    given = getattr(args, "given_options", frozenset())
+    for dest, reason in refused.items():
+        if dest in given:
+            raise FileError(f"--{dest.replace('_', '-')} is not for {route}: {reason}")
 
 
 def integer(value, opt, minimum=0, maximum=INT_MAX):
@@ -243,6 +271,60 @@ OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_ite
 """The arguments of lptv.identify and the options that set them, for the messages."""
 
 
+def add_record_options(p, several: bool = False):
+    """The options that say how a record is read and which of its lines are fitted, as every
+    command that fits a file has them (``lptv identify``, ``lptv select``): the period (--w0 /
+    --period), the sampling (--fs / --dt, --time), the channels, the periods kept (--periods,
+    --trim, --skip-periods), --detrend, the model's time base (--discrete, --ts) and --lines;
+    ``several``: --input / --output take comma lists (several channels)."""
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--w0", type=float, help="fundamental of the period (rad/s)")
+    g.add_argument("--period", type=float, metavar="T0", help="the period in seconds (w0 = 2 pi / T0)")
+    s = p.add_mutually_exclusive_group()
+    s.add_argument("--fs", type=float, metavar="HZ",
+                   help="sampling frequency of the record (Hz); the model stays continuous-time. With the "
+                        "period it gives the samples per period and splits a long record into whole periods")
+    s.add_argument("--dt", type=float, metavar="S", help="sampling time of the record (s), 1 / fs")
+    p.add_argument("--discrete", action="store_true",
+                   help="identify a discrete-time model (in the shift z) with the sample period 1 / fs")
+    p.add_argument("--ts", type=float, help="identify a DISCRETE-TIME model with this sample period (s); "
+                   "to state how the record was sampled for a continuous-time model use --fs or --dt")
+    p.add_argument("--input", metavar="NAME",
+                   help="the input channel: a CSV column, NPZ array or MAT variable (default u)"
+                        + ("; several as a comma list" if several else ""))
+    p.add_argument("--output", metavar="NAME",
+                   help="the output channel (default y)" + (
+                       "; several as a comma list (--input f1,f2 --output x1,x2): the files are then "
+                       "experiments of one system of several inputs and outputs" if several else "; one at a time"))
+    p.add_argument("--time", metavar="NAME",
+                   help="a time column or variable (s) giving fs, checked uniform (default: one named t or "
+                        "time); without --fs, --dt and --periods the file's time or stored fs / dt / Ts is used")
+    p.add_argument("--periods", type=int, metavar="P", help="number of periods in a CSV record (or a vector)")
+    p.add_argument("--trim", action="store_true",
+                   help="with --fs: drop the first samples of a long record to keep whole periods")
+    p.add_argument("--skip-periods", type=int, default=0, metavar="K",
+                   help="drop the first K periods (a start-up transient)")
+    p.add_argument("--detrend", action="store_true",
+                   help="take a linear drift out of each channel (the trend across the periods; each "
+                   "period's shape is kept)")
+    p.add_argument("--lines", help="lines of the fit, e.g. 1-243 or 1-100,120-150, or 'excited' (the lines "
+                   "the input excites, +-K for an LPTV model); default: all usable. The verdict always "
+                   "judges every row that reads a line with signal")
+    return p
+
+
+def sample_period(args, meas):
+    """The model's sample period: --ts, or 1 / fs with --discrete (None: continuous time); with
+    --discrete ``args.ts`` is set to it, as the commands' messages and summaries read it."""
+    if args.discrete and args.ts is not None:
+        raise FileError("--discrete takes the sample period from --fs / --dt; do not give --ts as well")
+    if args.discrete and meas.fs is None:
+        raise FileError("--discrete needs the sampling frequency --fs (or --dt)")
+    if args.discrete:
+        args.ts = 1.0 / meas.fs
+    return args.ts
+
+
 def read_options(args) -> dict:
     """The keyword arguments of lptv.read_measurements the options give (--periods, --fs / --dt,
     --period or --w0, --trim, --skip-periods, --input, --output, --time, --detrend)."""
@@ -258,6 +340,14 @@ def read_record(src, args, realisations: bool = False):
     """The periods of one file as the options say (:func:`read_options`); with ``realisations``
     also M x P x N records of random-phase realisations."""
     return read_measurements(src, **read_options(args), realisations=realisations)
+
+
+def dropped_note(meas):
+    """'dropped at the start: 40 samples (--trim), 6 periods (--skip-periods)', naming only what
+    was dropped; None when nothing was."""
+    parts = ([f"{meas.trimmed} sample{'s' * (meas.trimmed != 1)} (--trim)"] if meas.trimmed else []) \
+        + ([f"{meas.skipped} period{'s' * (meas.skipped != 1)} (--skip-periods)"] if meas.skipped else [])
+    return "dropped at the start: " + ", ".join(parts) if parts else None
 
 
 def describe_record(meas) -> str:

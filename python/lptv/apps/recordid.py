@@ -20,16 +20,35 @@ from __future__ import annotations
 import sys
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 from lptv import NumericalError, identify_record, read_measurements
-from lptv.apps.options import in_option_terms, integer, output_folder
+from lptv.apps.options import in_option_terms, integer, output_folder, refuse_given
 from lptv.apps.report import Report, write_json
+from lptv.apps import units
 from lptv.records.measurements import FileError
 from lptv.use.modelfile import context_of
 
 MODEL_ERRORS = 3
+REFUSED = {
+    "method": "the one-record fit is the output-error maximum likelihood of lptv.identify_record; --method "
+              "chooses the estimator of records of periods",
+    "known": "the one-record fit takes no known coefficients; --scale b0=1 gives the parameters in physical form",
+    "noise": "the one-record fit weighs by the noise level of its own residual; --noise chooses the noise "
+             "variances of records of periods",
+    "covariance": "the one-record fit's covariance is its inverse Fisher information",
+    "bootstrap": "the one-record fit's covariance is its inverse Fisher information",
+    "referred": "it is for a record of M x P x N random-phase realisations",
+    "remove_disturbances": "it is for records of periods",
+    "no_period_check": "the one-record fit does not check the record's period (it fits the record as cut)",
+    "periods": "the record is taken whole, in periods of --period (or --w0)",
+    "tol": "the one-record fit's iterations are bounded by --max-iter alone",
+    "lines": "--one-record fits the record's own lines",
+}
+"""The options of lptv identify that the one-record route does not honour, with the reason it
+refuses them (an option given and ignored would change nothing while the user thinks it did)."""
 
 
 def _fail(src, problem, status=2, names=None) -> int:
@@ -69,8 +88,12 @@ def run(args, names=None) -> int:
             raise FileError("--one-record needs the parameters' period: --period (s) or --w0 (rad/s)")
         if args.lines is not None:
             raise FileError("--lines is for periodic records; --one-record fits the record's own lines")
+        refuse_given(args, REFUSED, "--one-record")
+        scale = units.parse_scale(getattr(args, "scale", None))
+        integer(args.skip_periods, "--skip-periods")
         meas = read_measurements(src, fs=args.fs, dt=args.dt, period=period, trim=True, u=args.input,
-                                 y=args.output, time=args.time)
+                                 y=args.output, time=args.time, skip_periods=args.skip_periods,
+                                 detrend=bool(getattr(args, "detrend", False)))
         if meas.fs is None:
             raise FileError("--one-record needs the sampling frequency: a time column, a stored fs, or --fs")
         u, y = meas.u.ravel(), meas.y.ravel()
@@ -81,6 +104,7 @@ def run(args, names=None) -> int:
             res = identify_record(u, y, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=2 * np.pi / period, ts=ts,
                                   continuous=not discrete, max_iterations=max(args.max_iter, 1),
                                   input_noise_std=noise_std, seed=0)
+        physical = units.scaled(_corrected(res), *scale) if scale else None
     except NumericalError as e:
         return _fail(src, e, status=1, names=names)
     except (FileError, ValueError) as e:
@@ -89,22 +113,27 @@ def run(args, names=None) -> int:
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
     out.mkdir(parents=True, exist_ok=True)
     L, N0 = meas.u.shape
+    dropped = ([f"{meas.trimmed} samples"] if meas.trimmed else []) \
+        + ([f"{meas.skipped} periods (--skip-periods)"] if meas.skipped else [])
     print(f"lptv identify: {src} ({meas.format}, one record of {L} periods of {N0} samples, fs = {meas.fs:g} Hz, "
           f"{'discrete' if discrete else 'continuous'}-time model, {res.lines.size} lines"
-          + (f", {meas.trimmed} samples dropped at the start" if meas.trimmed else "") + ")")
+          + (f", {' and '.join(dropped)} dropped at the start" if dropped else "") + ")")
     print(f"  verdict: {res.verdict}")
-    width = max(len(n) for n in res.eta_names)
     corrected = res.input_noise_bias is not None
+    u_unit, y_unit = units.channel_unit(meas.input), units.channel_unit(meas.output)
     if corrected:
         print("  parameters corrected for the input's noise (the output-error estimate in summary.json):")
-    for name, v, s in zip(res.eta_names, res.eta_corrected, res.std_corrected):
-        print(f"  {name:<{width}}  {v: .6g}" + (f" +- {s:.3g}" if s > 0 else "  (normalisation)"))
+    print(units.format_parameters(_corrected(res), u_unit, y_unit))
+    if physical is not None:
+        print(f"  parameters in physical form (--scale {scale[0]}={scale[1]:g}):")
+        print(units.format_parameters(physical, u_unit, y_unit, scale=scale))
     for msg in list(res.warnings) + extra:
         print(f"  warning: {msg}")
     res.model.context = context_of({"route": "one record", "input": meas.input, "output": meas.output, "fs": meas.fs,
                                     "samples_per_period": N0, "ka": ka, "kb": kb, "method": "output error",
                                     "noise": "residual"}, res.model)
     res.model.save(out / "model.json")
+    unit_of = units.coefficient_units(res.model, u_unit, y_unit)
     write_json(out / "summary.json", {
         "file": str(src), "route": "one record", "periods": L, "samples_per_period": N0, "fs": meas.fs,
         "trimmed": meas.trimmed, "continuous": not discrete, "verdict": res.verdict, "model_ok": res.model_ok,
@@ -112,8 +141,10 @@ def run(args, names=None) -> int:
         "iterations": res.iterations,
         "verdict_test": {"F": res.record_verdict.statistic, "dof": list(res.record_verdict.dof),
                          "p_value": res.record_verdict.p_value, "alpha": res.record_verdict.alpha},
-        "parameters": {n: {"value": float(v), "std": float(s)}
+        "parameters": {n: {"value": float(v), "std": float(s), "unit": unit_of.get(n.split(".")[0], "")}
                        for n, v, s in zip(res.eta_names, res.eta, res.parameter_std)},
+        "scale": None if scale is None else {"coefficient": scale[0], "value": scale[1]},
+        "parameters_scaled": None if physical is None else units.table_with_units(physical, u_unit, y_unit, scale),
         "parameters_corrected_for_input_noise": None if not corrected else {
             n: {"value": float(v), "std": float(s), "bias": float(b)}
             for n, v, s, b in zip(res.eta_names, res.eta_corrected, res.std_corrected, res.input_noise_bias)},
@@ -121,7 +152,7 @@ def run(args, names=None) -> int:
     wrote = "model.json, summary.json"
     if not getattr(args, "no_report", False):
         try:
-            _report(res, src, L, N0, meas.fs, discrete).write(out)
+            _report(res, src, L, N0, meas.fs, discrete, u_unit, y_unit).write(out)
             wrote += ", report.html"
         except ImportError:
             wrote += " (no report.html: it needs matplotlib, pip install 'lptv[plots]')"
@@ -129,7 +160,16 @@ def run(args, names=None) -> int:
     return 0 if res.model_ok else MODEL_ERRORS
 
 
-def _report(res, src, L, N0, fs, discrete) -> Report:
+def _corrected(res):
+    """The parameters the command reports: the input-noise corrected ones when measured, with
+    their std (the bias estimate's own variance added), else the fit's."""
+    if res.input_noise_bias is None:
+        return res
+    cov = res.covariance + np.diag(res.std_corrected ** 2 - res.parameter_std ** 2)
+    return SimpleNamespace(model=res.model, eta_names=res.eta_names, eta=res.eta_corrected, covariance=cov)
+
+
+def _report(res, src, L, N0, fs, discrete, u_unit=None, y_unit=None) -> Report:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -147,9 +187,13 @@ def _report(res, src, L, N0, fs, discrete) -> Report:
                   "shows on the same line, a missing harmonic k on the input shifted by k w0.")
     rep.heading("Parameters")
     rep.paragraph("Normalised so that the mean of the highest output coefficient a_na is 1 (its std 0). To read "
-                  "them in physical units, divide every coefficient by the one you know (e.g. the mass).")
-    rep.table(["parameter", "estimate", "std"],
-              [[n, v, (s if s > 0 else "fixed")] for n, v, s in zip(res.eta_names, res.eta, res.parameter_std)])
+                  "them in physical units, multiply every coefficient by the mean of a_na you know (e.g. the "
+                  "mass, for a2 of m x'' + c x' + k x = F), or divide it by the mean of b0 (lptv identify "
+                  "--scale b0=1 does this, with the covariance).")
+    unit_of = units.coefficient_units(res.model, u_unit, y_unit)
+    rep.table(["parameter", "estimate", "std", "unit"],
+              [[n, *units.value_and_std(v, s), unit_of.get(n.split(".")[0], "")]
+               for n, v, s in zip(res.eta_names, res.eta, res.parameter_std)])
     w = res.lines * 2 * np.pi * fs / (L * N0)
     fig, ax = plt.subplots(figsize=(7, 3.5))
     ax.semilogy(w, np.abs(res.Y), ".", ms=3, label="measured |Y|")

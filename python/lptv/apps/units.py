@@ -140,3 +140,59 @@ def trajectories(src, t):
     C = cov[np.ix_(free, free)]
     var = np.einsum("tci,ij,tcj->tc", D, C, D)
     return values, np.sqrt(np.maximum(var, 0.0)), names
+
+
+def table_with_units(src, u_unit: Optional[str], y_unit: Optional[str],
+                     scale: Optional[Tuple[str, float]] = None) -> list:
+    """:func:`lptv.parameter_table` of ``src`` with each row's ``unit`` that of its coefficient
+    (:func:`coefficient_units`; a phase keeps 'deg'): what summary.json holds."""
+    from lptv.judgement.parameters import parameter_table
+
+    unit_of = coefficient_units(src.model, u_unit, y_unit, scale)
+    rows = parameter_table(src)
+    for r in rows:
+        r["unit"] = r["unit"] or unit_of.get(r["name"].split(".")[0], "")
+    return rows
+
+
+def value_and_std(value: float, std: float) -> Tuple[str, str]:
+    """('39.9991', '0.0018'): the value to the digits its std resolves (two significant digits of
+    the std), so that a value is never shown coarser than its own uncertainty; a std of 0 (the
+    normalisation, a fixed value) gives ('1', 'fixed')."""
+    if not (np.isfinite(std) and std > 0):
+        return f"{value:.6g}", "fixed"
+    decimals = int(max(0, 1 - np.floor(np.log10(std))))
+    if decimals > 12 or abs(value) >= 1e9:
+        return f"{value:.{max(6, min(16, decimals))}g}", f"{std:.2g}"
+    return f"{value:.{decimals}f}", f"{std:.2g}"
+
+
+def format_parameters(src, u_unit: Optional[str], y_unit: Optional[str],
+                      scale: Optional[Tuple[str, float]] = None) -> str:
+    """The parameters of ``src`` (a result or :func:`scaled`) as aligned lines: name, value to the
+    digits of its std, the std, the coefficient's unit where the channels state theirs."""
+    unit_of = coefficient_units(src.model, u_unit, y_unit, scale)
+    cov = src.covariance
+    std = np.zeros(len(src.eta_names)) if cov is None else np.sqrt(np.maximum(np.diag(cov), 0.0))
+    cells = [(n, *value_and_std(float(v), float(s)), unit_of.get(n.split(".")[0], ""))
+             for n, v, s in zip(src.eta_names, src.eta, std)]
+    w = [max(len(c[i]) for c in cells) for i in range(3)]
+    out = []
+    for n, v, s, u in cells:
+        sd = f"+- {s:<{w[2]}}" if s != "fixed" else f"   {'(normalisation)' if scale is None else '(by --scale)'}"
+        out.append((f"  {n:<{w[0]}}  {v:>{w[1]}} {sd}" + (f"  {u}" if u and s != "fixed" else "")).rstrip())
+    return "\n".join(out)
+
+
+def physical_form(physical, meas) -> Tuple[str, list]:
+    """What ``lptv identify --scale`` prints and keeps of :func:`scaled` ``physical`` for the record
+    ``meas`` (its channels' names state the units): (the text for the terminal, the rows of
+    summary.json's ``parameters_scaled``), both with each coefficient's unit."""
+    from lptv.judgement.parameters import format_parameter_table
+
+    name, value = physical.scale
+    u_unit, y_unit = channel_unit(meas.input), channel_unit(meas.output)
+    unit_of = coefficient_units(physical.model, u_unit, y_unit, physical.scale)
+    text = (f"parameters in physical form (--scale {name}={value:g}):\n"
+            + format_parameter_table(physical, units=unit_of).replace("(normalised)", "(by --scale)"))
+    return text, table_with_units(physical, u_unit, y_unit, physical.scale)

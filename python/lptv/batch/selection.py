@@ -12,13 +12,16 @@ import numpy as np
 from .._validate import as_int, as_positive_float, as_str
 from .executors import describe_executor, one_blas_thread, require, run_tasks
 from ..spectra.frequency_data import FrequencyData, frequency_data_of
-from ..estimation.identify import IdentificationResult, _rows, identify
+from ..estimation.identify import IdentificationResult, _rows, excited_rows, identify
 from ..spectra.htf_estimate import HtfEstimate, htf_estimate
 
 CRITERIA = ("mdl", "aic")
 # Columns of the ranked table, in order.
-COLUMNS = ("rank", "na", "nb", "k", "n_free_parameters", "method", "V", "aic", "mdl", "residue_ok",
-           "fraction_above_0db", "converged", "nearly_unidentifiable", "V_wgtls", "error", "warnings")
+COLUMNS = ("rank", "na", "nb", "k", "n_free_parameters", "method", "V", "aic", "mdl", "verdict", "model_ok",
+           "residue_ok", "fraction_above_0db", "converged", "nearly_unidentifiable", "V_wgtls", "error",
+           "model_errors", "warnings")
+# The verdict column's words: lptv.identify's verdict of the candidate (IdentificationResult.verdict).
+VERDICTS = ("consistent", "MODEL ERRORS", "NOT DETERMINED", "failed")
 # The HTF guide estimates at most this many branches each side.
 MAX_GUIDE_BRANCHES = 10
 
@@ -28,8 +31,10 @@ class SelectionResult:
     """What :func:`select` returns: the ranked candidates and the chosen structure."""
 
     rows: Tuple[dict, ...] = field(repr=False)
-    """One dict per candidate (keys ``COLUMNS``), best first: sorted by (passes the residue test,
-    refined by SML, the criterion, the number of parameters); failed fits last."""
+    """One dict per candidate (keys ``COLUMNS``), best first: sorted by (the verdict finds no
+    model error, refined by SML, the criterion, the number of parameters); failed fits last.
+    ``verdict`` is the verdict :func:`lptv.identify` gives the candidate's fit ('consistent',
+    'MODEL ERRORS', 'NOT DETERMINED'), ``model_errors`` its reasons."""
     choice: Tuple[int, int, int]
     """(na, nb, k) of the first row."""
     result: IdentificationResult = field(repr=False)
@@ -40,7 +45,8 @@ class SelectionResult:
     correction: float
     """c = (P-1)/(P-2): the penalties are multiplied by it (noise variances from P periods)."""
     choice_ok: bool
-    """False when every candidate failed the residue test (the choice is then only the least bad)."""
+    """False when the verdict finds model errors in every candidate (the choice is then only the
+    least bad)."""
     htf: Optional[HtfEstimate] = field(default=None, repr=False)
     """The nonparametric HTF the harmonic count is guided by (None if the excitation is too dense)."""
     htf_harmonics: Optional[int] = None
@@ -58,13 +64,13 @@ class SelectionResult:
         """The first ``top`` rows of the ranking, the choice and the warnings, as text."""
         top = as_int(top, "top", minimum=1)
         out = [f"{'rank':>4} {'na':>3} {'nb':>3} {'k':>3} {'n':>4} {'method':>6} {'V':>11} "
-               f"{'aic':>11} {'mdl':>11} {'>0dB':>6}  residue"]
+               f"{'aic':>11} {'mdl':>11} {'>0dB':>6}  verdict"]
         for r in self.rows[:top]:
             if r["error"]:
                 out.append(f"{r['rank']:4d} {r['na']:3d} {r['nb']:3d} {r['k']:3d}  failed: {r['error']}")
                 continue
-            flag = "ok" if r["residue_ok"] else "REJECTED"
-            if r["nearly_unidentifiable"]:
+            flag = r["verdict"]
+            if r["nearly_unidentifiable"] and r["verdict"] != "NOT DETERMINED":
                 flag += ", nearly unidentifiable"
             out.append(f"{r['rank']:4d} {r['na']:3d} {r['nb']:3d} {r['k']:3d} {r['n_free_parameters']:4d} "
                        f"{r['method']:>6} {r['V']:11.5g} {r['aic']:11.5g} {r['mdl']:11.5g} "
@@ -73,7 +79,7 @@ class SelectionResult:
             out.append(f"... {len(self.rows) - top} more")
         na, nb, k = self.choice
         out.append(f"choice ({self.criterion.upper()}): na = {na}, nb = {nb}, k = {k}"
-                   + ("" if self.choice_ok else "  (EVERY candidate fails the residue test)"))
+                   + ("" if self.choice_ok else "  (the verdict rejects EVERY candidate)"))
         if self.htf_harmonics is not None:
             out.append(f"nonparametric HTF: branches up to |k| = {self.htf_harmonics} stand above the noise "
                        f"(tested up to {self.htf.branches})")
@@ -145,21 +151,25 @@ def fit_structure(item, shared) -> dict:
         V = 2.0 * float(np.sum(res.normalized_residue ** 2))   # its diagonal approximation
     n = int(res.n_free_parameters)
     p_aic, p_mdl = _penalties(n, n_rows, shared["c"])
+    errors = tuple(res.model_errors)
+    verdict = "MODEL ERRORS" if errors else ("NOT DETERMINED" if res.undetermined is not None else "consistent")
     return dict(na=na, nb=nb, k=k, n_free_parameters=n, method=method, V=V, aic=V + p_aic, mdl=V + p_mdl,
+                verdict=verdict, model_ok=not errors,
                 residue_ok=bool(res.residue_ok), fraction_above_0db=float(res.fraction_above_0db),
                 converged=bool(res.converged), nearly_unidentifiable=bool(res.nearly_unidentifiable),
-                error="", warnings="; ".join(warns))
+                error="", model_errors="; ".join(errors), warnings="; ".join(warns))
 
 
 def _failed(item, failure) -> dict:
     na, nb, k, method = item
     return dict(na=na, nb=nb, k=k, n_free_parameters=0, method=method, V=math.inf, aic=math.inf,
-                mdl=math.inf, residue_ok=False, fraction_above_0db=math.nan, converged=False,
-                nearly_unidentifiable=False, error=failure.message, warnings="")
+                mdl=math.inf, verdict="failed", model_ok=False, residue_ok=False, fraction_above_0db=math.nan,
+                converged=False, nearly_unidentifiable=False, error=failure.message, model_errors="",
+                warnings="")
 
 
 def _key(criterion):
-    return lambda r: (bool(r["error"]), not r["residue_ok"], r["method"] != "sml", r[criterion],
+    return lambda r: (bool(r["error"]), not r["model_ok"], r["method"] != "sml", r[criterion],
                       r["n_free_parameters"], r["na"], r["nb"], r["k"])
 
 
@@ -190,10 +200,12 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
       MDL (the default) is consistent: an unneeded parameter lowers V by about c chi2(1) and
       costs c ln(2|R|) (6 to 7 for a few hundred rows); AIC's 2 c lets an unneeded group of d
       parameters in with probability P(chi2(d) > 2d) (3 % for d = 10) however long the record;
-    - the residue test (``IdentificationResult.residue_ok``): a structure it rejects is never
-      chosen while another passes. The ranking is by (passes, refined by SML, criterion, n).
+    - the verdict (``IdentificationResult.model_ok``, what :func:`lptv.identify` says of the
+      candidate's fit: its residue tests, cost and prediction error): a structure it rejects is
+      never chosen while another passes. The ranking is by (passes, refined by SML, criterion, n).
 
-    The rows are those of the largest k in the grid (k_max + 1 .. Lmax - k_max), or ``lines``:
+    The rows are those of the largest k in the grid (k_max + 1 .. Lmax - k_max), or ``lines``
+    (``'excited'``: the excited lines and those within +-k_max of them, :func:`lptv.identify`'s):
     criteria compare costs on the same equations only. The nonparametric HTF
     (:func:`lptv.htf_estimate`, at the largest branch count the excitation allows) guides the
     harmonic count: without ``k`` the grid is k = 0 .. the highest branch above the noise.
@@ -207,8 +219,9 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
         At most :data:`MAX_GRID` (2000) structures in all.
     w0, ts : float
         Fundamental (rad/s); sample period for discrete time.
-    lines : sequence of int, optional
-        Rows of every fit (default: those of the largest k).
+    lines : sequence of int or 'excited', optional
+        Rows of every fit (default: those of the largest k; 'excited': the input's excited lines
+        and their neighbours within +-k_max, the same for every candidate).
     criterion : {'mdl', 'aic'}
     refine : int
         How many of the best WGTLS candidates (those passing the residue test first) are refitted
@@ -225,7 +238,7 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
     -------
     SelectionResult
         ``rows`` ranked, ``choice`` (na, nb, k), ``result`` its fit, ``summary()``, ``table()``.
-        Warns (and says in ``warnings``) when every candidate fails the residue test.
+        Warns (and says in ``warnings``) when the verdict rejects every candidate.
 
     Examples
     --------
@@ -269,6 +282,10 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
         rows = list(range(k_max + 1, data.max_line - k_max + 1))
         if not rows:
             raise ValueError(f"k: the largest k ({k_max}) leaves no rows in lines 0..{data.max_line}")
+    elif isinstance(lines, str):
+        if lines != "excited":
+            raise ValueError(f"lines must be a sequence of integers or 'excited', got {lines!r}")
+        rows = [int(x) for x in excited_rows(data, k_max)]
     else:
         rows = _rows(lines)
     P = data.periods
@@ -281,9 +298,9 @@ def select(u, y=None, *, na, nb, k=None, w0: Optional[float] = None, ts: Optiona
     scored, ranked = _rank(grid, k_list, shared, criterion, refine, executor, workers, progress)
     top = ranked[0]
     choice = (top["na"], top["nb"], top["k"])
-    choice_ok = bool(top["residue_ok"])
+    choice_ok = bool(top["model_ok"])
     if not choice_ok:
-        notes.insert(0, f"EVERY candidate fails the residue test: the choice na = {choice[0]}, nb = {choice[1]}, "
+        notes.insert(0, f"the verdict rejects EVERY candidate: the choice na = {choice[0]}, nb = {choice[1]}, "
                      f"k = {choice[2]} is only the least bad by {criterion.upper()}; widen the grid "
                      "(orders, harmonics) or check the data")
         warnings.warn(notes[0], UserWarning, stacklevel=2)
@@ -310,9 +327,9 @@ def _rank(grid, k_list, shared, criterion, refine, executor, workers, progress):
     for r in scored:
         r["V_wgtls"] = r["V"]
     if refine:
-        # the shortlist per harmonic count: the diagonal WGTLS cost ignores the correlation of
-        # rows that share lines, which grows with k, and drops far more than the exact cost when k
-        # is overestimated; its scores are compared within one k only
+        # the shortlist per harmonic count (those the verdict passes first): the diagonal WGTLS
+        # cost ignores the correlation of rows that share lines, which grows with k, and drops far
+        # more than the exact cost when k is overestimated; its scores are compared within one k only
         ordered = [r for r in sorted(scored, key=_key(criterion)) if not r["error"]]
         best = [r for kk in k_list for r in [r for r in ordered if r["k"] == kk][:refine]]
         items = [(r["na"], r["nb"], r["k"], "sml") for r in best]

@@ -221,9 +221,12 @@ def _num(v, s=None):
     return f"{v:.6g} +- {s:.2g}"
 
 
-def format_parameter_table(obj, level: float = 0.95) -> str:
-    """:func:`parameter_table` (and for an LTI model :func:`lti_table`) as aligned text."""
+def format_parameter_table(obj, level: float = 0.95, units: Optional[dict] = None) -> str:
+    """:func:`parameter_table` (and for an LTI model :func:`lti_table`) as aligned text;
+    ``units`` ({'a0': 'N/m', ...}) names each coefficient's unit after its interval."""
     rows = parameter_table(obj, level)
+    for r in rows:
+        r["unit"] = r["unit"] or (units or {}).get(r["name"].split(".")[0], "")
     pct = f"{100 * level:g} %"
     lines = [f"  {'parameter':12s} {'value':>12s} {'std':>10s}   {pct + ' interval':>27s}"]
     for r in rows:

@@ -25,6 +25,7 @@ from .channels import FileError
 from .scan import (ALPHA, NOISE_HALF_WINDOW, REPEAT_LIMIT, SIGMAS, WHOLE, LineClass,  # noqa: F401
                          _classify, _detrended, _drift, _output_multiple, _pooled, _residue_at, _spectra,
                          _threshold, _transient, find_period, repeat_residue)
+from .scan import TRANSIENT_LEFT, TransientSkip, transient_skip
 
 __all__ = ["Inspection", "LineClass", "inspect"]
 
@@ -81,7 +82,11 @@ class Inspection:
     (the larger of input and output; about 1 in steady state)."""
     transient_limit: float
     transient_periods: int
-    """Leading periods to drop (--skip-periods)."""
+    """Leading periods to drop (--skip-periods): those that differ from the steady ones, and more
+    until what is left of the transient in the mean of the kept periods is below
+    :data:`TRANSIENT_LEFT` of that mean's noise power (:attr:`transient`)."""
+    transient: TransientSkip
+    """How ``transient_periods`` was counted: the periods seen, the decay, what is left."""
     lines: np.ndarray
     """The excited lines (of the period's grid)."""
     spacing: int
@@ -227,9 +232,15 @@ class Inspection:
                    + (" (--trim drops them)" if self.leftover else ""))
         if self.transient_ratios.size:
             first = float(self.transient_ratios[0])
+            tr = self.transient
             if self.transient_periods:
-                out.append(f"transient:   the first period differs from the steady ones by {first:.3g} times what the "
-                           f"noise explains (limit {self.transient_limit:.3g}): drop {self.transient_periods} "
+                seen = ("the first period differs" if tr.seen == 1 else f"the first {tr.seen} periods differ")
+                more = ("" if tr.periods == tr.seen else
+                        f"; it decays by {-10 * math.log10(tr.decay):.3g} dB a period, and {tr.periods} dropped leave "
+                        f"{tr.left:.2g} of the kept periods' noise power in their mean (at most {TRANSIENT_LEFT:g}: "
+                        "no bias)")
+                out.append(f"transient:   {seen} from the steady ones (the first by {first:.3g} times what the "
+                           f"noise explains, limit {self.transient_limit:.3g}){more}: drop {self.transient_periods} "
                            f"(--skip-periods {self.transient_periods})")
             else:
                 out.append(f"transient:   none seen (first period {first:.3g} times the noise, limit "
@@ -481,6 +492,7 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         return Inspection(**common, repeats=False, input_period_samples=None, input_period_exact=None, period_samples=None,
                           repeat_ratio=rr, output_repeats=False, output_repeat_ratio=np.nan, periods=0, leftover=0,
                           transient_ratios=np.zeros(0), transient_limit=np.nan, transient_periods=0,
+                          transient=TransientSkip(0, 0, math.nan, 0.0, True),
                           lines=np.zeros(0, int), spacing=0, weak_input_lines=np.zeros(0, int),
                           input_snr_db=np.zeros(0), output_snr_db=np.zeros(0), reach=0, classes=(),
                           time_variation_reach=0, threshold=np.nan, spectrum_lines=np.zeros(0, int),
@@ -514,11 +526,15 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         n_ref = max(2, (P + 1) // 2)
         ratios = np.maximum(_transient(us, n_ref), _transient(ys, n_ref))
         limit = max(1.0 + SIGMAS * math.sqrt(2.0 / N + 2.0 / (N * (n_ref - 1))), 1.5)
-        skip = 0
-        while skip < ratios.size and ratios[skip] > limit:
-            skip += 1
+        tr = transient_skip(ratios, limit, P, n_ref)
     else:
-        ratios, limit, skip = np.zeros(0), np.nan, 0
+        ratios, limit, tr = np.zeros(0), np.nan, TransientSkip(0, 0, math.nan, 0.0, True)
+    skip = tr.periods
+    if not tr.enough:
+        notes.append(f"the start-up transient lasts too long for this record: dropping {skip} of its {P} periods "
+                     f"still leaves {tr.left:.2g} times the noise power of the kept periods' mean in it (at most "
+                     f"{TRANSIENT_LEFT:g} leaves no bias): record more periods, or identify it as one record "
+                     "with its transient (--one-record)")
     Ps = P - skip
     lines, U, varU = _spectra(us[skip:])
     _, Y, varY = _spectra(ys[skip:])
@@ -551,7 +567,7 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
     return Inspection(**common, repeats=True, input_period_samples=L, input_period_exact=Lf, period_samples=N,
                       repeat_ratio=_residue_at(uu, L), output_repeats=bool(r_y <= OUTPUT_REPEAT_LIMIT),
                       output_repeat_ratio=float(r_y), periods=P, leftover=left, transient_ratios=ratios,
-                      transient_limit=float(limit), transient_periods=skip, lines=excited, spacing=s,
+                      transient_limit=float(limit), transient_periods=skip, transient=tr, lines=excited, spacing=s,
                       weak_input_lines=weak, input_snr_db=snr_u, output_snr_db=snr_y, reach=K, classes=classes,
                       time_variation_reach=k_tv, threshold=t, spectrum_lines=lines, U=U, Y=Y,
                       noise_u=nu / Ps, noise_y=ny / Ps, notes=tuple(notes))

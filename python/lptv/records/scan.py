@@ -265,6 +265,65 @@ def _transient(xs, n_ref):
     return np.array(out)
 
 
+TRANSIENT_LEFT = 0.01
+"""The most power a start-up transient may leave in the mean of the kept periods, as a share of
+that mean's own noise power (METHOD.md section 18, "Periods and transient"): the periods to drop
+are counted until what is left of the transient is below it."""
+
+
+@dataclass(frozen=True)
+class TransientSkip:
+    """How many leading periods to drop so that the transient leaves no bias (METHOD.md section 18)."""
+
+    periods: int
+    """Leading periods to drop (--skip-periods)."""
+    seen: int
+    """Leading periods that differ from the steady ones by more than noise does (one period's test)."""
+    decay: float
+    """The transient's power from one period to the next (rho^2; nan when none is seen)."""
+    left: float
+    """What the transient leaves in the mean of the kept periods, over that mean's noise power (0
+    when none is seen; an upper estimate)."""
+    enough: bool
+    """False when even the most periods that may be dropped (all but 2) leave more than
+    :data:`TRANSIENT_LEFT`: the record is too short for its transient."""
+
+
+def transient_skip(ratios, limit: float, periods: int, n_ref: int) -> TransientSkip:
+    """The leading periods to drop, from each leading period's ratio to the noise (:func:`_transient`)
+    of one channel. The periods above ``limit`` are seen; the transient's power in period p,
+    e_p = (r_p - 1) in units of one sample's noise, decays by rho^2 per period (fitted to the seen
+    periods' log e_p; with one period seen, the slowest decay that leaves the next below the limit).
+    Dropping K >= seen periods leaves in the mean of the P - K kept ones a transient of power at
+    most e_K (1 + 1/n_ref) ((1 - rho^(P-K)) / (1 - rho))^2 / (P - K)^2, which must be at most
+    TRANSIENT_LEFT times the mean's noise power s^2 / (P - K)."""
+    r = np.asarray(ratios, float)
+    seen = 0
+    while seen < r.size and r[seen] > limit:
+        seen += 1
+    if seen == 0:
+        return TransientSkip(0, 0, math.nan, 0.0, True)
+    e = np.maximum(r[:seen] - 1.0, 1e-300)
+    if seen >= 2:
+        slope = float(np.polyfit(np.arange(seen), np.log(e), 1)[0])
+    else:
+        slope = math.log(max(limit - 1.0, 1e-300) / e[0])
+    decay = math.exp(min(slope, 0.0))
+    rho = math.sqrt(decay)
+
+    def left(K):
+        kept = periods - K
+        eK = e[K] if K < seen else e[-1] * decay ** (K - seen + 1)
+        gain = kept if rho >= 1 else (1 - rho ** kept) / (1 - rho)
+        return float(eK * (1 + 1 / n_ref) * gain ** 2 / kept)
+
+    K = seen
+    while K < periods - 2 and left(K) > TRANSIENT_LEFT:
+        K += 1
+    K = min(K, max(periods - 2, 0))
+    return TransientSkip(K, seen, decay, left(K), left(K) <= TRANSIENT_LEFT)
+
+
 def _spectra(xs):
     """Mean spectrum (DFT / N) on lines 1..N/2 - 1 and the per-line variance over the periods."""
     P, N = xs.shape
