@@ -356,7 +356,7 @@ class WeightedRows {
   }
 
   Eigen::VectorXd variance(const Eigen::VectorXcd& theta) const {
-    if (full_) return full_residue_variance(d_, p_, rows_, rn_, theta);
+    if (full_) return row_noise_variance(d_, p_, rows_, rn_, theta);
     if (!cached_) return residue_variance(d_, p_, rows_, theta);
     Eigen::VectorXcd z(static_cast<Eigen::Index>(pairs_.size()));
     for (size_t e = 0; e < pairs_.size(); ++e) z[static_cast<Eigen::Index>(e)] = std::conj(theta[pairs_[e].first]) * theta[pairs_[e].second];

@@ -133,7 +133,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
   // the rows' noise from the realisations (METHOD.md section 20) where the fit took it
   auto full = [&](size_t e) { return opt.full_rows && has_row_noise(*ds[e]); };
   auto variance = [&](size_t e) {
-    return full(e) ? full_residue_variance(*ds[e], p, rows[e], er.theta) : residue_variance(*ds[e], p, rows[e], er.theta);
+    return full(e) ? row_noise_variance(*ds[e], p, rows[e], er.theta) : residue_variance(*ds[e], p, rows[e], er.theta);
   };
   if (E == 1) {
     res.residue = residue(*ds[0], p, rows[0], er.theta);

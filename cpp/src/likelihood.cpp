@@ -363,16 +363,6 @@ void ExactLikelihood::set_row_scale(const Eigen::VectorXd& scale) {
   for (size_t i = 0; i < sorted_.size(); ++i) scale_[static_cast<Eigen::Index>(i)] = scale[order_[i]];
 }
 
-Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
-                                const Eigen::VectorXcd& theta) {
-  const Eigen::VectorXd line = residue_variance(d, p, rows, theta);
-  const Eigen::VectorXd full = full_residue_variance(d, p, rows, theta);
-  Eigen::VectorXd s(line.size());
-  for (Eigen::Index r = 0; r < s.size(); ++r)
-    s[r] = (line[r] > 0 && full[r] > 0) ? std::sqrt(full[r] / line[r]) : 1.0;
-  return s;
-}
-
 ExactLikelihood::Evaluation ExactLikelihood::evaluate(const Eigen::VectorXcd& theta) const {
   return evaluate(factor(theta), true);
 }

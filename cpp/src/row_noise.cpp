@@ -4,6 +4,7 @@
 
 #include "lptv/estimators.hpp"
 #include "lptv/jacobian.hpp"
+#include "lptv/likelihood.hpp"
 #include "rows.hpp"
 
 namespace lptv {
@@ -73,6 +74,43 @@ Eigen::MatrixXd full_real_column_covariance(const FrequencyData& d, const Parame
   const Eigen::MatrixXd CJ =
       detail::real_congruence(p, detail::text_entries(p), [&](int a, int b) { return C(a, b); }, false);
   return 0.5 * (CJ + CJ.transpose());
+}
+
+Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                const RowNoise& rn, const Eigen::VectorXcd& theta) {
+  const Eigen::VectorXd line = residue_variance(d, p, rows, theta);
+  const Eigen::VectorXd full = full_residue_variance(d, p, rows, rn, theta);
+  Eigen::VectorXd s = Eigen::VectorXd::Ones(line.size());
+  // pooled over the full rows within +-kRowNoisePool lines: each row's own ratio has the 2 (P - 1)
+  // degrees of freedom of one sample variance, the pooled one those of up to 2 kRowNoisePool + 1
+  // (the ratio is smooth in frequency where the noise spectra are)
+  for (size_t r = 0; r < rows.size(); ++r) {
+    if (!rn.full_rows[r]) continue;
+    double num = 0, den = 0;
+    for (size_t j = 0; j < rows.size(); ++j) {
+      if (!rn.full_rows[j] || std::abs(rows[j] - rows[r]) > kRowNoisePool) continue;
+      num += full[static_cast<Eigen::Index>(j)];
+      den += line[static_cast<Eigen::Index>(j)];
+    }
+    if (num > 0 && den > 0) s[static_cast<Eigen::Index>(r)] = std::sqrt(num / den);
+  }
+  return s;
+}
+
+Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                const Eigen::VectorXcd& theta) {
+  return row_noise_scale(d, p, rows, row_noise(d, p, rows), theta);
+}
+
+Eigen::VectorXd row_noise_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                   const RowNoise& rn, const Eigen::VectorXcd& theta) {
+  const Eigen::VectorXd s = row_noise_scale(d, p, rows, rn, theta);
+  return residue_variance(d, p, rows, theta).cwiseProduct(s.cwiseAbs2());
+}
+
+Eigen::VectorXd row_noise_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                   const Eigen::VectorXcd& theta) {
+  return row_noise_variance(d, p, rows, row_noise(d, p, rows), theta);
 }
 
 }  // namespace lptv

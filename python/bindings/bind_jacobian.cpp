@@ -20,7 +20,15 @@ void bind_jacobian(py::module_& m) {
                                           const std::vector<int>& rows, const Eigen::VectorXd& w) {
     return lptv::full_real_column_covariance(d, p, rows, lptv::row_noise(d, p, rows), w);
   }, "data"_a, "par"_a, "rows"_a, "weights"_a);
-  m.def("row_noise_scale", &lptv::row_noise_scale, "data"_a, "par"_a, "rows"_a, "theta"_a);
+  m.def("row_noise_scale",
+        py::overload_cast<const lptv::FrequencyData&, const lptv::Parametrisation&, const std::vector<int>&,
+                          const Eigen::VectorXcd&>(&lptv::row_noise_scale),
+        "data"_a, "par"_a, "rows"_a, "theta"_a);
+  m.def("row_noise_variance",
+        py::overload_cast<const lptv::FrequencyData&, const lptv::Parametrisation&, const std::vector<int>&,
+                          const Eigen::VectorXcd&>(&lptv::row_noise_variance),
+        "data"_a, "par"_a, "rows"_a, "theta"_a,
+        "The rows' variances the record's routes weigh by: eq. 15 times row_noise_scale^2 (METHOD.md section 20).");
   m.def("has_row_noise", &lptv::has_row_noise, "data"_a);
   m.def("gsvd_pairs", [](const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
     const auto g = lptv::gsvd_pairs(A, B);

@@ -245,8 +245,14 @@ def test_the_rows_noise_from_the_realisations_against_the_record_s_bins(loop):
     v = np.asarray(_core.full_residue_variance(d._cpp, par, rows, res.theta))
     # sums of 7 squares of sums of 9 products: rounding ~1e-15 relative
     np.testing.assert_allclose(v, v_ref, rtol=1e-12)
-    # the fit's own residue variances are these
-    np.testing.assert_allclose(res.residue_variance, v_ref, rtol=1e-12)
+    # the fit weighs by eq. 15 times the ratio of the realisations' variances to eq. 15's pooled
+    # over the rows within +-3 lines (METHOD.md section 20)
+    line = np.asarray(_core.residue_variance(d._cpp, par, rows, res.theta))
+    r_ = np.asarray(rows)
+    pooled = np.array([v_ref[np.abs(r_ - l) <= 3].sum() / line[np.abs(r_ - l) <= 3].sum() for l in r_])
+    np.testing.assert_allclose(np.asarray(_core.row_noise_scale(d._cpp, par, rows, res.theta)) ** 2, pooled,
+                               rtol=1e-12)
+    np.testing.assert_allclose(res.residue_variance, line * pooled, rtol=1e-12)
     # CJ_W from the realisations: Re(T^H sum_l w_l Phi_l^H Phi_l T), whose quadratic form at any
     # xi is the weighted noise of the rows at theta = T xi: sum_l w_l var e_l(theta); random xi
     # (as many as CJ has entries) pin the whole symmetric matrix

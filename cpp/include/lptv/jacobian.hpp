@@ -49,6 +49,18 @@ Eigen::VectorXd full_residue_variance(const FrequencyData& d, const Parametrisat
                                       const RowNoise& rn, const Eigen::VectorXcd& theta);
 Eigen::VectorXd full_residue_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
                                       const Eigen::VectorXcd& theta);
+// D of ExactLikelihood::set_row_scale: d_r = sqrt(sum full / sum eq. 15) over the full rows
+// within +-kRowNoisePool lines of row r (1 on the rows that keep eq. 15), and the rows' variances
+// d_r^2 times eq. 15 that the fits weigh by (METHOD.md section 20).
+constexpr int kRowNoisePool = 3;
+Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                const RowNoise& rn, const Eigen::VectorXcd& theta);
+Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                const Eigen::VectorXcd& theta);
+Eigen::VectorXd row_noise_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                   const RowNoise& rn, const Eigen::VectorXcd& theta);
+Eigen::VectorXd row_noise_variance(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
+                                   const Eigen::VectorXcd& theta);
 // CJ_W = Re(Text^H C Text), C = sum_l w_l C_l with C_l = phi_l^H phi_l on the full rows and
 // E{dJ_l^H dJ_l} of eq. 15's noise on the others.
 Eigen::MatrixXd full_real_column_covariance(const FrequencyData& d, const Parametrisation& p,

@@ -133,11 +133,6 @@ ExactFit minimise_exact_cost(const ExactLikelihood& lik, const Parametrisation& 
 ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Parametrisation& p,
                              const Eigen::VectorXcd& theta0, double tol, int max_iter);
 
-// sqrt(full_residue_variance / residue_variance) per row: D of ExactLikelihood::set_row_scale
-// for the rows' noise from the realisations (1 on rows that keep eq. 15).
-Eigen::VectorXd row_noise_scale(const FrequencyData& d, const Parametrisation& p, const std::vector<int>& rows,
-                                const Eigen::VectorXcd& theta);
-
 // Cov(q - lambda CJ_W xi) over the free entries of xi (free_indices order) from the terms of
 // one experiment or their sum over independent experiments (one lambda for all):
 // Cov(q) - c v^T - v c^T + Var(R) v v^T, c = Cov(q, R), v = CJ_W xi / (xi^T CJ_W xi).

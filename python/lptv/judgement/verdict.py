@@ -214,7 +214,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         elif d_fit is d:
             wfit.append(np.diag(S_blocks[-1]))
         else:   # WGTLS weighs Re and Im of row l alike, by 2 / var e_l
-            variance = _core.full_residue_variance if scale is not None else _core.residue_variance
+            variance = _core.row_noise_variance if scale is not None else _core.residue_variance
             wfit.append(np.repeat(np.asarray(variance(d_fit._cpp, par, [int(l) for l in srt], theta)), 2) / 2)
         J_blocks.append(_real_jacobian(np.asarray(_core.jacobian(d._cpp, par, [int(l) for l in srt])), T, free))
         if nu_line is not None:   # a row reads lines l-K..l+K: the fewest of their dof (line 0 aside)
