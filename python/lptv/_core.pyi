@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedCovariances', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'gsvd_pairs', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_covariances', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedCovariances', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'full_real_column_covariance', 'full_residue_variance', 'gsvd_pairs', 'has_row_noise', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_covariances', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'row_noise_scale', 'row_noise_variance', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -86,6 +86,11 @@ class FrequencyData:
         """
         The statistics from the record's bins between the lines (METHOD.md section 20): Up, Yp the periods' spectra (P, lines), Ur, Yr the rfft of the P periods concatenated / (P N).
         """
+    @staticmethod
+    def with_realisations(data: FrequencyData, noiseU: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], noiseY: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], like: FrequencyData) -> FrequencyData:
+        """
+        A copy of data with the noise realisations noiseU, noiseY on the lines and offsets of like's.
+        """
     def __init__(self, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], Y: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], varU: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], varY: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], covYU: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], periods: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
     @property
@@ -105,6 +110,15 @@ class FrequencyData:
         ...
     @property
     def noiseY(self) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
+        ...
+    @property
+    def noise_first(self) -> int:
+        ...
+    @property
+    def noise_last(self) -> int:
+        ...
+    @property
+    def noise_offset(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
     @property
     def periods(self) -> int:
@@ -227,6 +241,10 @@ class ExactLikelihood:
     def second_order_meat(self, par: Parametrisation, theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
         Cov(q - lambda CJ_W xi) over the free entries of xi: the second-order noise of WGTLS's estimating equation (METHOD.md section 10), one experiment.
+        """
+    def set_row_scale(self, scale: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
+        """
+        S = D S_line D with D = diag(scale), one entry per row in the caller's order (METHOD.md section 20).
         """
     @property
     def half_bandwidth(self) -> int:
@@ -823,15 +841,23 @@ def floquet_mimo(model: MimoModel, tol: typing.SupportsFloat | typing.SupportsIn
     """
     Multipliers and exponents of the matrix system (see lptv.floquet for the documented API).
     """
+def full_real_column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    ...
+def full_residue_variance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    """
+    var e_l from the data's noise realisations, each row at its bins' own frequencies (METHOD.md section 20); eq. 15 on rows that read a line without realisations.
+    """
 def gsvd_pairs(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], B: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], int]:
+    ...
+def has_row_noise(data: FrequencyData) -> bool:
     ...
 def htf(model: Model, L: typing.SupportsInt | typing.SupportsIndex, lines: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], solver: str = 'auto') -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
 def htf_estimate(data: FrequencyData, excited: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], branches: typing.SupportsInt | typing.SupportsIndex) -> HtfEstimate:
     ...
-def identify(data: FrequencyData, structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] = [], covariance: bool = True) -> Identification:
+def identify(data: FrequencyData, structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex] = [], covariance: bool = True, full_rows: bool = False) -> Identification:
     ...
-def identify_experiments(experiments: collections.abc.Sequence[FrequencyData], structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]] = [], covariance: bool = True) -> Identification:
+def identify_experiments(experiments: collections.abc.Sequence[FrequencyData], structure: Structure, method: str = 'wgtls', tol: typing.SupportsFloat | typing.SupportsIndex = 1e-10, max_iter: typing.SupportsInt | typing.SupportsIndex = 50, rows: collections.abc.Sequence[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]] = [], covariance: bool = True, full_rows: bool = False) -> Identification:
     """
     Several experiments of one system fitted into one model (lptv::identify on a list).
     
@@ -953,6 +979,12 @@ def residue_variance(data: FrequencyData, par: Parametrisation, rows: collection
     ...
 def residue_variance_gradient(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]:
     ...
+def row_noise_scale(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    ...
+def row_noise_variance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], theta: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    """
+    The rows' variances the record's routes weigh by: eq. 15 times row_noise_scale^2 (METHOD.md section 20).
+    """
 def schroeder_phases(amplitudes: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     ...
 def simulate(model: Model, U: typing.Annotated[numpy.typing.ArrayLike, numpy.complex128, "[m, n]"], solver: str = 'auto', lines_out: typing.SupportsInt | typing.SupportsIndex = -1, guard: typing.SupportsInt | typing.SupportsIndex = -1, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-13, max_guard: typing.SupportsInt | typing.SupportsIndex = -1) -> dict:

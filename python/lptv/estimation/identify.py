@@ -21,6 +21,11 @@ NOISES = ("auto", "sample", "moderated", "full", "full-moderated")
 # (lines 0 and Lmax, outliers) have 1-4 degrees of freedom, and the checks that read the moderated
 # data's periods for every line (the input's presence, the rows with signal) would misjudge them.
 AUTO_MIN_PERIODS = 4
+# noise='auto' on the record's statistics moderates from this many periods: at P = 4 the rows'
+# realisations (2 (P - 1) = 6 degrees of freedom each) make the moderated fits' intervals cover
+# 85-92 % on bench_process_noise.py's rig, the record's sample variances 97.6-99.4 %
+# (METHOD.md section 20)
+AUTO_MIN_PERIODS_RECORD = 8
 COVARIANCES = ("analytic", "bootstrap", "realisations", "none")
 
 
@@ -471,6 +476,10 @@ def _auto_noise(datas, covariance):
 
     pairs, why = [], []
     for d in datas:
+        if full and d.periods < AUTO_MIN_PERIODS_RECORD:
+            return sample, say("the sample variances", (
+                f"{d.periods} periods (on the record's noise the moderated route needs {AUTO_MIN_PERIODS_RECORD}: "
+                f"each row's terms between lines come from {d.periods - 1} realisations)")), None
         if d.periods < AUTO_MIN_PERIODS:
             return sample, say("the sample variances", (
                 f"{d.periods} periods (the moderated route needs {AUTO_MIN_PERIODS}: the lines that keep "
