@@ -50,6 +50,7 @@ SMOKE = {
     "bench_floquet.py": ["--rounds", "1", "--inner", "1"],
     "bench_floquet_cost.py": ["--rounds", "1", "--bootstrap", "10"],
     "bench_floquet_coverage.py": ["--runs", "2", "--periods", "4", "--workers", "1", "--systems", "ct-real", "dt"],
+    "bench_floquet_mimo_coverage.py": ["--runs", "1", "--periods", "8", "--workers", "1"],
     "bench_htf_overlap.py": ["1"],
     "bench_identifiability.py": ["2"],
     "bench_inspect.py": ["--runs", "12"],
