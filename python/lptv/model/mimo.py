@@ -275,7 +275,7 @@ class MimoModel:
         try:
             m = cls(parts["a_real"] + 1j * parts["a_imag"], parts["b_real"] + 1j * parts["b_imag"], w0=w0, ts=ts)
             if "context" in d:
-                from .use.modelfile import check_context
+                from ..use.modelfile import check_context
 
                 m.context = check_context(d["context"], m)
         except ValueError as e:

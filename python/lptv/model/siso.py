@@ -144,7 +144,7 @@ class Model:
         >>> bool(np.isclose(H[0], 2 / (1j + 3), rtol=1e-14))
         True
         """
-        from .use.export import to_scipy
+        from ..use.export import to_scipy
 
         return to_scipy(self)
 
@@ -153,7 +153,7 @@ class Model:
         LTI model or of the frozen system at time ``t``; an LPTV model without ``t`` is refused with
         the reason (a ValueError). Needs the optional extra ``pip install 'lptv[control]'``."""
         if t is None:
-            from .use.export import refuse_lptv
+            from ..use.export import refuse_lptv
 
             refuse_lptv(self, "to_control")
         try:
