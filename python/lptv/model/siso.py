@@ -359,7 +359,7 @@ class Model:
                 raise ValueError("lptv.Model description: covariance contains NaN or inf")
             m.covariance, m.eta_names = cov, tuple(names)
         if "context" in d:
-            from .use.modelfile import check_context
+            from ..use.modelfile import check_context
 
             try:
                 m.context = check_context(d["context"], m)
