@@ -94,6 +94,7 @@ struct HillEigen {
   Eigen::VectorXcd lambda;
   Eigen::VectorXd centroid;  // mean harmonic index of the eigenvector, weighted by |v_p|^2
   Eigen::VectorXd rounding;  // eps ||H|| / rcond (LAPACK's error bound), times T0
+  Eigen::MatrixXcd left, right;  // the eigenvectors (columns; left: u^H H = lambda u^H)
 };
 
 HillEigen hill_eigen(const std::vector<Eigen::MatrixXcd>& F, int na, double w0, int M) {
@@ -140,6 +141,8 @@ HillEigen hill_eigen(const std::vector<Eigen::MatrixXcd>& F, int na, double w0, 
     out.centroid[j] = moment / mass;
     out.rounding[j] = rconde[j] > 0 ? kEps * abnrm / rconde[j] * T0 : kInf;
   }
+  out.left = std::move(VL);
+  out.right = std::move(VR);
   return out;
 }
 
@@ -307,7 +310,8 @@ void check_options(const FloquetOptions& opt) {
 
 namespace detail {
 
-Floquet hill_floquet(const std::vector<Eigen::MatrixXcd>& F, double w0, const FloquetOptions& opt) {
+Floquet hill_floquet(const std::vector<Eigen::MatrixXcd>& F, double w0, const FloquetOptions& opt,
+                     HillVectors* vectors) {
   const double T0 = 2.0 * M_PI / w0;
   if (F.empty() || F[0].rows() == 0) {
     Floquet f = finish({}, {}, {}, w0, true);
@@ -353,6 +357,17 @@ Floquet hill_floquet(const std::vector<Eigen::MatrixXcd>& F, double w0, const Fl
         err[i] = std::max(d, rounding[i]);
       }
       if (settled) {
+        if (vectors) {
+          vectors->truncation = M;
+          vectors->lambda.resize(na);
+          vectors->left.resize(h.left.rows(), na);
+          vectors->right.resize(h.right.rows(), na);
+          for (int i = 0; i < na; ++i) {
+            vectors->lambda[i] = cur[i];
+            vectors->left.col(i) = h.left.col(kept[i]);
+            vectors->right.col(i) = h.right.col(kept[i]);
+          }
+        }
         Floquet f = finish(cur, err, {}, w0, true);
         f.method = "hill";
         f.truncation = M;
@@ -406,6 +421,8 @@ Floquet product_floquet(const DtProduct& prod, double w0, double T0) {
 }
 
 void check_floquet_options(const FloquetOptions& opt) { check_options(opt); }
+
+std::vector<Eigen::MatrixXcd> siso_companion_blocks(const Model& m) { return companion_blocks(m); }
 
 }  // namespace detail
 

@@ -255,7 +255,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
           if (full(0)) lik.set_row_scale(row_noise_scale(*ds[0], p, rows[0], er.theta));
           if (opt.method == Method::SML) {
             // The information the fit's last step computed at this very theta (the same sum).
-            Eigen::MatrixXd F = er.information.size() ? er.information : lik.fisher_information(er.theta);
+            Eigen::MatrixXd F = er.information.size() && !full(0) ? er.information : lik.fisher_information(er.theta);
             cov_free = symmetric_inverse(F, "the Fisher information");
           } else {
             // The sandwich with the estimating equation's second-order noise in its meat.
@@ -270,7 +270,7 @@ Identification identify_experiments(const std::vector<const FrequencyData*>& ds,
           Eigen::Index at = 0;
           for (size_t e = 0; e < E; ++e) {
             const Eigen::Index n = static_cast<Eigen::Index>(rows[e].size());
-            if (opt.method == Method::SML && er.information.size()) {  // the fit's, summed already
+            if (opt.method == Method::SML && er.information.size() && !full(e)) {  // the fit's, summed already
               bread = er.information;
               break;
             }

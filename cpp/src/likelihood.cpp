@@ -443,6 +443,15 @@ Eigen::MatrixXd symmetric_inverse(const Eigen::MatrixXd& F, const char* what) {
 }
 
 Eigen::MatrixXd ExactLikelihood::fisher_information(const Eigen::VectorXcd& theta) const {
+  if (scale_.size()) {
+    // The information takes the Jacobian at the denoised spectra x0 alone: the gradient's
+    // (1 - d_r) J_r(x) holds the data's noise, whose square would add E{dJ^T S^-1 dJ} to it.
+    const Factor f = factor(theta);
+    Eigen::MatrixXd J = real_jacobian(evaluate(f, false).denoised);
+    forward_solve(f.Lb, kd_, J);
+    const Eigen::MatrixXd Jw = free_columns(J, p_.free_indices());
+    return Jw.transpose() * Jw;
+  }
   const Evaluation ev = evaluate(theta);
   const Eigen::MatrixXd Jw = free_columns(ev.jacobian, p_.free_indices());
   return Jw.transpose() * Jw;
@@ -465,7 +474,8 @@ ExactLikelihood::SandwichTerms ExactLikelihood::sandwich_terms(const Eigen::Vect
   const int R = static_cast<int>(sorted_.size());
   if (weights.size() != R) throw std::invalid_argument("weights must have one entry per row");
   const Factor f = factor(theta);
-  Eigen::MatrixXd J = free_columns(evaluate(f, false).jacobian, p_.free_indices());
+  Eigen::MatrixXd J = free_columns(scale_.size() ? real_jacobian(evaluate(f, false).denoised)
+                                                 : evaluate(f, false).jacobian, p_.free_indices());
   // H = J^T W J and J^T W S W J = (L^T W J)^T (L^T W J), both symmetric (rank updates, half
   // the flops of a product). Built on the transposes (columns = real rows), so that L^T is
   // applied to contiguous vectors: Xt = (W J)^T, column j of (L^T W J)^T = sum_i L(i, j) Xt(:, i).

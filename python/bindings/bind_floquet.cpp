@@ -21,6 +21,21 @@ void bind_floquet(py::module_& m) {
     return lptv::floquet(model, opt);
   }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
         "Multipliers and exponents of the homogeneous equation (see lptv.floquet for the documented API).");
+  py::class_<lptv::FloquetSensitivity>(m, "FloquetSensitivity",
+                                       "Floquet exponents with their first-order sensitivity to a(t) (lptv::floquet_sensitivity).")
+      .def_readonly("floquet", &lptv::FloquetSensitivity::floquet)
+      .def_readonly("gradient", &lptv::FloquetSensitivity::gradient)
+      .def_readonly("condition", &lptv::FloquetSensitivity::condition);
+  m.def("floquet_sensitivity", [](const lptv::Model& model, double tol, int min_truncation, int max_truncation) {
+    lptv::FloquetOptions opt;
+    opt.tol = tol;
+    opt.min_truncation = min_truncation;
+    opt.max_truncation = max_truncation;
+    py::gil_scoped_release release;  // the eigenvalue problems are C++ only
+    return lptv::floquet_sensitivity(model, opt);
+  }, "model"_a, "tol"_a = 1e-11, "min_truncation"_a = 8, "max_truncation"_a = 256,
+        "Floquet exponents with d lambda_i / d a_{n,h} (gradient[i], (na+1) x (2Ka+1)) and each eigenvalue's\n"
+        "condition number (see lptv.floquet of an identification result).");
   m.def("floquet_mimo", [](const lptv::MimoModel& model, double tol, int min_truncation, int max_truncation) {
     lptv::FloquetOptions opt;
     opt.tol = tol;

@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import scipy.sparse
 import typing
-__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedCovariances', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'full_real_column_covariance', 'full_residue_variance', 'gsvd_pairs', 'has_row_noise', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_covariances', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'row_noise_scale', 'row_noise_variance', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
+__all__: list[str] = ['ChannelPower', 'CrestResult', 'DataDiagnosis', 'DistortionLines', 'EstimateResult', 'ExactLikelihood', 'FDS_MAX_CONDITION', 'FDS_WARN_CONDITION', 'Floquet', 'FloquetSensitivity', 'FrequencyData', 'HtfEstimate', 'Identification', 'MODERATION_MAX_PRIOR_DOF', 'MODERATION_OUTLIER_RATE', 'MimoEstimate', 'MimoFit', 'MimoModel', 'MimoStructure', 'Model', 'ModeratedCovariances', 'ModeratedNoise', 'NumericalError', 'Parametrisation', 'ProductRadius', 'RecordFit', 'Structure', 'band_matrix', 'column_covariance', 'covariance_correction', 'cramer_rao_bound', 'cramer_rao_bound_experiments', 'crest_factor', 'default_solver', 'diagnose_data', 'digamma', 'distortion_lines', 'estimate', 'eta_covariance', 'excited_lines', 'expected_fraction_above_0db', 'f_upper_quantile', 'fit_record', 'floquet', 'floquet_mimo', 'floquet_sensitivity', 'full_real_column_covariance', 'full_residue_variance', 'gsvd_pairs', 'has_row_noise', 'htf', 'htf_estimate', 'identify', 'identify_experiments', 'incomplete_beta', 'jacobian', 'lp_norm_log', 'mimo_band_matrix', 'mimo_fisher', 'mimo_fit', 'mimo_free_indices', 'mimo_htf', 'mimo_residues', 'mimo_row_degrees', 'mimo_sandwich', 'mimo_sml', 'mimo_state_matrix', 'mimo_wgtls', 'minimize_crest_factor', 'moderated_covariances', 'moderated_noise', 'monodromy', 'monodromy_mimo', 'multisine_spectrum', 'product_spectral_radius', 'real_column_covariance', 'record_prediction', 'record_regression', 'residue', 'residue_variance', 'residue_variance_gradient', 'row_noise_scale', 'row_noise_variance', 'schroeder_phases', 'simulate', 'simulate_mimo', 'spectrum', 'tetragamma', 'time_signal', 'trigamma', 'trigamma_inverse', 'weighted_r_factor']
 class NumericalError(ArithmeticError):
     pass
 class Model:
@@ -724,6 +724,19 @@ class Floquet:
     @property
     def truncation(self) -> int:
         ...
+class FloquetSensitivity:
+    """
+    Floquet exponents with their first-order sensitivity to a(t) (lptv::floquet_sensitivity).
+    """
+    @property
+    def condition(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def floquet(self) -> Floquet:
+        ...
+    @property
+    def gradient(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.complex128], "[m, n]"]]:
+        ...
 class ProductRadius:
     """
     The spectral radius of the monodromy matrix by products (lptv::product_spectral_radius).
@@ -840,6 +853,11 @@ def floquet(model: Model, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-
 def floquet_mimo(model: MimoModel, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-11, min_truncation: typing.SupportsInt | typing.SupportsIndex = 8, max_truncation: typing.SupportsInt | typing.SupportsIndex = 256) -> Floquet:
     """
     Multipliers and exponents of the matrix system (see lptv.floquet for the documented API).
+    """
+def floquet_sensitivity(model: Model, tol: typing.SupportsFloat | typing.SupportsIndex = 1e-11, min_truncation: typing.SupportsInt | typing.SupportsIndex = 8, max_truncation: typing.SupportsInt | typing.SupportsIndex = 256) -> FloquetSensitivity:
+    """
+    Floquet exponents with d lambda_i / d a_{n,h} (gradient[i], (na+1) x (2Ka+1)) and each eigenvalue's
+    condition number (see lptv.floquet of an identification result).
     """
 def full_real_column_covariance(data: FrequencyData, par: Parametrisation, rows: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], weights: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...

@@ -293,7 +293,7 @@ def test_readme_mathieu_example_runs():
     """The Mathieu example of the user guide (docs/guide/06-structure.md; the README links it)."""
     root = Path(__file__).resolve().parents[2]
     text = "\n".join(p.read_text() for p in [root / "README.md", *sorted((root / "docs" / "guide").glob("*.md"))])
-    blocks = [b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if "lptv.floquet(" in b]
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", text, flags=re.S) if "f = lptv.floquet(m)" in b]
     assert len(blocks) == 1, "the README and the guide have no Floquet example, or several"
     ns = {}
     exec(compile(blocks[0], "06-structure.md", "exec"), ns)

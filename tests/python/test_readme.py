@@ -10,9 +10,9 @@ DOCS = [README] + sorted((ROOT / "docs" / "guide").glob("*.md"))
 MARKERS = ("lptv.frozen_poles(res.model", "lptv.inspect(", "lptv.read_measurements(", "lptv.montecarlo(",
            "records.append(", "lptv.plots.distortion(d)", "lptv.min_crest_multisine(", "transient_record(",
            "continuous=True", 'referred="input"', 'referred="none"', 'disturbances="remove"',
-           "lptv.mimo_htf_estimate(", "lptv.floquet(", "lptv.select(", "res.noise_choice",
+           "lptv.mimo_htf_estimate(", "f = lptv.floquet(m)", "lptv.select(", "res.noise_choice",
            'u=["f1", "f2"]', "from lptv import floquet, frozen_poles", "lptv.validate(model",
-           "kp * (r(t) - x)")
+           "kp * (r(t) - x)", "f.stable_probability")
 
 
 def all_text():
@@ -333,3 +333,23 @@ def test_guide_feedback_example_runs(tmp_path, monkeypatch, capsys):
     truth = np.array([30.0, 3.75, 0.0, 1.0, 1.0, 1.0])
     free = res.parameter_std > 0
     assert np.all(np.abs(res.eta - truth)[free] < 4 * res.parameter_std[free])
+
+
+def test_guide_floquet_with_uncertainty(tmp_path, monkeypatch):
+    """The guide's exponents with their intervals (METHOD.md section 22): the true model's exponents
+    within 4 std, the shapes printed. The truth by Hill's method (test_floquet.py checks it against
+    exact multipliers and products): at T0 = 126 s the multipliers e^-60 .. e^-126 lie below the
+    rounding of any product of the period, solve_ivp's included."""
+    import numpy as np
+
+    import lptv
+
+    ns = run_block("f.stable_probability", tmp_path, monkeypatch)
+    f, d = ns["f"], ns["d"]
+    true = lptv.floquet(d["model"]).exponents
+    for lam, s in zip(f.exponents, f.exponents_std):
+        t = true[np.argmin(np.abs(true - lam))]
+        assert abs(t.real - lam.real) < 4 * s[0] and abs(t.imag - lam.imag) < 4 * s[1] + 1e-9
+    assert f.confidence_interval(0.95).shape == (3, 2, 2)
+    assert ns["poles"].std.shape == (64, 3, 2)
+    assert ns["band"].magnitude_band().shape == (3, 20, 2)

@@ -56,6 +56,23 @@ struct Floquet {
 // converge by opt.max_truncation (naming the M reached) or 1/a_na(t) needs too many harmonics.
 Floquet floquet(const Model& m, const FloquetOptions& opt = FloquetOptions());
 
+// First-order sensitivity of the Floquet exponents to the coefficients of a(t) (METHOD.md
+// section 22): the eigenvalue's derivative from its left and right eigenvectors,
+// d lambda = u^H dH v / (u^H v), H Hill's matrix at the settled truncation (continuous time) or
+// the monodromy matrix of the product (discrete time, d lambda = d mu / (mu T0)).
+struct FloquetSensitivity {
+  Floquet floquet;  // as floquet(m, opt) returns it
+  // gradient[i](n, Ka + h) = d lambda_i / d a_{n,h} (n = 0..na, h = -Ka..Ka), for the exponents in
+  // floquet.exponents' order, with a_{n,h} and a_{n,-h} taken as independent complex variables
+  // (a real perturbation of harmonic h > 0 moves both: Re d a_{n,h} (g_h + g_-h), and so on).
+  // b(t) does not enter. Zero for an exponent of -inf (a zero discrete-time multiplier).
+  std::vector<Eigen::MatrixXcd> gradient;
+  // |u| |v| / |u^H v| of each exponent's eigenvalue: its condition number (inf for a defective
+  // or zero one), large where two exponents meet.
+  Eigen::VectorXd condition;
+};
+FloquetSensitivity floquet_sensitivity(const Model& m, const FloquetOptions& opt = FloquetOptions());
+
 // Several outputs (METHOD.md section 19, "Stability of the matrix system"): the multipliers of
 // sum_n A_n(t) d^n y = 0 for a row-reduced A(t, s) (row degrees d_p, the leading row coefficient
 // matrix L(t), row p from A_{d_p}(t), invertible over the period). The state is the observer

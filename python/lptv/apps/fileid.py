@@ -48,6 +48,7 @@ import numpy as np
 
 from lptv import (NumericalError, check_record, compare, frozen_poles, frozen_zeros, identify, lti_table,
                   parameter_table, plots, simulate)
+from lptv.apps.stability import stability_section, stability_summary, stability_text
 from lptv.apps.options import (OPTION_NAMES, describe_record, fundamental, in_option_terms, integer,  # noqa: F401
                                output_folder, parse_counts, parse_known, parse_lines, positive, read_options,
                                read_record, add_record_options, sample_period, dropped_note)
@@ -299,6 +300,9 @@ def run(args) -> int:
     if dropped_note(meas):
         print(dropped_note(meas))
     print(res.summary())
+    stab = stability_summary(res)
+    if stab is not None:
+        print(stability_text(stab))
     if physical is not None:
         print(units.physical_form(physical, meas)[0])
     for msg in extra:
@@ -309,6 +313,7 @@ def run(args) -> int:
     summary = _summary(args, meas, w0, ka, kb, res, Y_pred, extra)
     summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
     summary["parameters_scaled"] = None if physical is None else units.physical_form(physical, meas)[1]
+    summary["stability_uncertainty"] = stab
     failed = write_fit(out, res.model, summary, None if getattr(args, "no_report", False) else
                        lambda: _report(src, meas, res, Y_pred, summary, known=known))
     return _fail(failed[0] or src, failed[1]) if failed else verdict_status(res)
@@ -421,6 +426,7 @@ def _report(src, meas, res, Y_pred, summary, known=None) -> Report:
                   "The model is rejected: " + "; ".join(res.model_errors) + "."))
     residue_tests_section(rep, res)
 
+    stability_section(rep, summary.get("stability_uncertainty"))
     rep.heading("The model")
     t = np.linspace(0.0, model.period, 400)
     ax = plots.frozen_poles_zeros(t, poles_est=frozen_poles(model, t), zeros_est=frozen_zeros(model, t),

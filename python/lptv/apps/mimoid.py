@@ -33,6 +33,7 @@ from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fun
                                output_folder, parse_counts, parse_lines, positive, read_options)
 from lptv.apps import inspectrec
 from lptv.apps.report import write_fit
+from lptv.apps.stability import stability_summary, stability_text
 from lptv.records.measurements import FileError, read_measurements
 
 NEEDS_FIT = ("several inputs or outputs need the MIMO fit (lptv.identify on arrays (P, N, nu), (P, N, ny)), "
@@ -178,10 +179,14 @@ def run(args) -> int:
     print(text_summary(res))
     stability = stability_of(res.model)
     print(f"stability: {stability['text']}")
+    stab = stability_summary(res)
+    if stab is not None:
+        print(stability_text(stab))
     for msg in list(getattr(res, "warnings", ())) + notes:
         print(f"warning: {msg}")
     summary = json_summary(args, records, w0, ts, ka, kb, res, notes)
     summary["stability"] = {k: v for k, v in stability.items() if k != "text"}
+    summary["stability_uncertainty"] = stab
     if getattr(args, "no_report", False):
         report = None
     else:

@@ -156,6 +156,15 @@ class IdentificationResult:
         half = norm_ppf(0.5 + level / 2.0) * self.parameter_std
         return np.column_stack([self.eta - half, self.eta + half])
 
+    def htf_band(self, lines=None, branches=(0,), *, level: float = 0.95):
+        """The model's HTF branches G_k(j w_l) at ``lines`` (default: the excited lines) with their
+        first-order covariance: a :class:`lptv.judgement.uncertainty.HtfBand` (METHOD.md section 22)."""
+        from .uncertainty import htf_band
+
+        if self.covariance is None:
+            raise ValueError(f"htf_band: {self._no_covariance()[0]}")
+        return htf_band(self, lines, branches, level=level)
+
     def _no_covariance(self) -> Tuple[str, str]:
         """Why ``covariance`` is None: (the error's message, the summary's note)."""
         if self.covariance_option == "none":

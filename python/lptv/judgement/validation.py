@@ -76,8 +76,12 @@ def _frozen_roots(coef_at, t, order, what):
     return out
 
 
-def frozen_poles(model, t) -> np.ndarray:
+def frozen_poles(model, t=None) -> np.ndarray:
     """Roots of sum_n a_n(t) s^n (z^n in discrete time) at each t: array (len(t), na).
+
+    Of an identification result: a :class:`lptv.judgement.uncertainty.FrozenPoles` with the
+    poles of its model and their first-order std (METHOD.md section 22); ``t`` defaults to 64
+    times over the period there.
 
     They say nothing about the stability of the time-varying system (:func:`lptv.floquet`
     does). Where a_na(t) vanishes a pole goes to infinity (reported as inf).
@@ -106,8 +110,15 @@ def frozen_poles(model, t) -> np.ndarray:
     """
     if isinstance(model, MimoModel):
         return _frozen_poles_mimo(model, as_real_1d(t, "t"))
+    if not isinstance(model, Model) and isinstance(getattr(model, "model", None), Model) \
+            and hasattr(model, "covariance"):
+        from .uncertainty import frozen_poles_of  # a result: the poles with their std
+
+        return frozen_poles_of(model, t, roots=frozen_poles)
     if not isinstance(model, Model):
         raise ValueError(f"model must be an lptv.Model or lptv.MimoModel, got {type(model).__name__}")
+    if t is None:
+        raise ValueError("t must be given for a model (the times of the frozen poles)")
     return _frozen_roots(model.a_at, t, model.na, "poles")
 
 

@@ -1,7 +1,7 @@
 """Stability of the periodic system: Floquet multipliers and exponents (METHOD.md section 12)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
 import numpy as np
@@ -55,6 +55,65 @@ class FloquetResult:
     """'hill' (continuous time) or 'product' (discrete time)."""
     period: float
     """T0 = 2 pi / w0 in seconds."""
+    exponents_std: Optional[np.ndarray] = None
+    """Of an identification result (METHOD.md section 22): (n, 2), the std of Re and Im of each
+    exponent (1/s, rad/s); None for a model."""
+    exponents_covariance: Optional[np.ndarray] = field(default=None, repr=False)
+    """First order: (2n, 2n), the covariance of (Re l_0, Im l_0, Re l_1, ...); bootstrap: the draws'."""
+    stable_probability: Optional[float] = None
+    """P(every decay rate Re lambda_i < 0) under the estimate's distribution (the normal
+    approximation of the first-order route, or the bootstrap draws' fraction); None for a model."""
+    first_order_ok: Optional[bool] = None
+    """False where first order does not hold (a repeated exponent, a pair about to split or to
+    meet: see ``uncertainty_notes``); None for a model."""
+    uncertainty_notes: Tuple[str, ...] = ()
+    """Sentences on the intervals: where first order fails, an undecided stability."""
+    uncertainty_method: Optional[str] = None
+    """'first-order' or 'bootstrap' (None for a model)."""
+    condition: Optional[np.ndarray] = field(default=None, repr=False)
+    """First order, one output: each exponent's eigenvalue condition number |u| |v| / |u^H v|."""
+    draws: Optional[np.ndarray] = field(default=None, repr=False)
+    """Bootstrap: the exponents of the B draws (B, n), on the branches of ``exponents``."""
+
+    def _need_uncertainty(self):
+        if self.exponents_std is None:
+            raise ValueError("this FloquetResult carries no uncertainty: pass the identification result "
+                             "(lptv.floquet(res)), not its model")
+
+    def confidence_interval(self, level: float = 0.95) -> np.ndarray:
+        """(n, 2, 2): ``[i, 0]`` the interval of Re lambda_i (1/s), ``[i, 1]`` that of Im lambda_i
+        (rad/s, on the branch of ``exponents``), two-sided at ``level``: the normal one
+        (first order) or the draws' percentiles (bootstrap)."""
+        from .._dist import norm_ppf
+        from .._validate import as_float
+
+        level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
+        self._need_uncertainty()
+        lam = self.exponents
+        if self.draws is not None:
+            q = np.array([0.5 - level / 2, 0.5 + level / 2])
+            re = np.quantile(self.draws.real, q, axis=0).T
+            im = np.quantile(self.draws.imag, q, axis=0).T
+            return np.stack([re, im], axis=1)
+        z = float(norm_ppf(0.5 + level / 2.0))
+        mid = np.stack([lam.real, lam.imag], axis=1)
+        return np.stack([mid - z * self.exponents_std, mid + z * self.exponents_std], axis=2)
+
+    @property
+    def multiplier_modulus_std(self) -> np.ndarray:
+        """First-order std of |mu_i| = exp(T0 Re lambda_i): T0 |mu_i| std(Re lambda_i)."""
+        self._need_uncertainty()
+        return self.period * np.abs(self.multipliers_of_exponents) * self.exponents_std[:, 0]
+
+    @property
+    def multipliers_of_exponents(self) -> np.ndarray:
+        """The multipliers in the order of ``exponents``, exp(lambda_i T0)."""
+        return np.exp(self.exponents * self.period)
+
+    def multiplier_modulus_interval(self, level: float = 0.95) -> np.ndarray:
+        """(n, 2): the interval of |mu_i| (in the order of ``exponents``), the exact image
+        exp(T0 [low, high]) of Re lambda_i's interval."""
+        return np.exp(self.period * self.confidence_interval(level)[:, 0, :])
 
 
 def _check_model(model, mimo=False):
@@ -67,7 +126,8 @@ def _check_model(model, mimo=False):
 
 
 def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
-            max_truncation: int = 256) -> FloquetResult:
+            max_truncation: int = 256, method: str = "first-order", draws: int = 400,
+            seed=None, level: float = 0.95) -> FloquetResult:
     """Characteristic multipliers and Floquet exponents of ``model``: is it stable?
 
     The homogeneous equation ``sum_n a_n(t) d^n y/dt^n = 0`` in the state
@@ -104,11 +164,26 @@ def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
     above: Hill's method in continuous time, the product of the N one-step matrices in discrete
     time. A 1 x 1 model gives the multipliers of the SISO model.
 
+    Of an identification result (METHOD.md section 22), the exponents carry the estimate's
+    uncertainty: ``exponents_std``, ``confidence_interval(level)`` (n, 2, 2),
+    ``stable_probability``, ``multiplier_modulus_interval(level)``; first order through the
+    eigenvalue derivative of Hill's matrix (of the monodromy product in discrete time; several
+    outputs: central differences of the core's exponents), with ``first_order_ok`` and
+    ``uncertainty_notes`` saying where it does not hold, or ``method='bootstrap'``: ``draws``
+    models drawn from N(eta, covariance), each one's exponents.
+
     Parameters
     ----------
-    model : lptv.Model or lptv.MimoModel
+    model : lptv.Model, lptv.MimoModel or an identification result
         a_na(t) (several outputs: L(t)) must not vanish (be singular) over the period
-        (continuous time: checked on a fine grid; discrete time: at the N samples).
+        (continuous time: checked on a fine grid; discrete time: at the N samples). A result
+        (of :func:`lptv.identify`) needs its covariance (not ``covariance='none'``).
+    method : {'first-order', 'bootstrap'}
+        Of a result: how the covariance reaches the exponents.
+    draws, seed : int, optional
+        The bootstrap's number of draws and its seed.
+    level : float
+        Of a result: the level at which ``uncertainty_notes`` says whether stability is decided.
     tol : float
         Continuous time: convergence tolerance of the truncation on ln(mu_i).
     min_truncation, max_truncation : int
@@ -158,10 +233,13 @@ def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
     >>> f.multipliers.size, f.is_stable
     (4, False)
     """
-    _check_model(model, mimo=True)
     tol = as_positive_float(tol, "tol")
     min_truncation = as_int(min_truncation, "min_truncation", minimum=1)
     max_truncation = as_int(max_truncation, "max_truncation", minimum=1)
+    if not isinstance(model, (Model, MimoModel)) and hasattr(model, "covariance"):
+        return _of_result(model, dict(tol=tol, min_truncation=min_truncation, max_truncation=max_truncation),
+                          method, draws, seed, level)
+    _check_model(model, mimo=True)
     route = _core.floquet_mimo if isinstance(model, MimoModel) else _core.floquet
     r = route(model._cpp, tol=tol, min_truncation=min_truncation,
               max_truncation=max_truncation)
@@ -171,6 +249,57 @@ def floquet(model, *, tol: float = 1e-11, min_truncation: int = 8,
         error_estimate=np.asarray(r.error_estimate), truncation=int(r.truncation),
         harmonics=int(r.harmonics), convergence=float(r.convergence), method=r.method,
         period=model.period if not model.discrete else model.samples_per_period * model.ts)
+
+
+def _from_core(r, model, **extra) -> FloquetResult:
+    return FloquetResult(
+        multipliers=np.asarray(r.multipliers), exponents=np.asarray(r.exponents),
+        is_stable=bool(r.is_stable), spectral_radius=float(r.spectral_radius),
+        error_estimate=np.asarray(r.error_estimate), truncation=int(r.truncation),
+        harmonics=int(r.harmonics), convergence=float(r.convergence), method=r.method,
+        period=model.period if not model.discrete else model.samples_per_period * model.ts, **extra)
+
+
+def _of_result(res, opt, method, draws, seed, level) -> FloquetResult:
+    """The exponents of ``res.model`` with their uncertainty (METHOD.md section 22)."""
+    from . import floquet_uncertainty as fu
+    from .._validate import as_float
+
+    if method not in ("first-order", "bootstrap"):
+        raise ValueError(f"method must be 'first-order' or 'bootstrap', got {method!r}")
+    level = as_float(level, "level", minimum=0.0, maximum=1.0, open_min=True, open_max=True)
+    model = fu.source(res)[0]
+    w0 = model.w0
+    if method == "bootstrap":
+        draws = as_int(draws, "draws", minimum=10)
+        r, lam, d = fu.bootstrap(res, opt, draws, seed)
+        X = np.empty((draws, 2 * lam.size))
+        X[:, 0::2], X[:, 1::2] = d.real, d.imag
+        fin = np.all(np.isfinite(X), axis=0)
+        C = np.zeros((X.shape[1],) * 2)
+        C[np.ix_(fin, fin)] = np.cov(X[:, fin], rowvar=False).reshape(fin.sum(), fin.sum())
+        p = float(np.mean(np.all(d.real < 0, axis=1)))
+        notes = []
+        extra = dict(draws=d, stable_probability=p, first_order_ok=None, condition=None)
+    else:
+        r, lam, C, cond = fu.first_order(res, opt)
+        idx = fu.distinct_rates(lam, w0)
+        p = fu.stable_probability(lam.real[idx], C[np.ix_(2 * idx, 2 * idx)])
+        notes = list(fu.first_order_notes(lam, C, cond, w0))
+        extra = dict(stable_probability=p, first_order_ok=not notes, condition=cond)
+    std = np.sqrt(np.maximum(np.stack([np.diag(C)[0::2], np.diag(C)[1::2]], axis=1), 0.0))
+    T0 = model.period if not model.discrete else model.samples_per_period * model.ts
+    err = np.asarray(r.error_estimate)
+    err_re = (err if not model.discrete else np.log1p(err)) / T0
+    for i in np.flatnonzero(np.isfinite(lam.real) & ~(err_re < std[:, 0])):
+        notes.append(f"exponent {i} ({lam[i].real:.4g}{lam[i].imag:+.4g}j) is computed no better than its std "
+                     f"(numerical error {err_re[i]:.2g} 1/s): its interval is not resolved")
+    if method == "first-order":
+        extra["first_order_ok"] = not notes
+    if lam.size and 1 - level < p < level:
+        notes.append(f"stability is not decided at level {level:g}: P(stable) = {p:.4g}")
+    return _from_core(r, model, exponents_std=std, exponents_covariance=C, uncertainty_method=method,
+                      uncertainty_notes=tuple(notes), **extra)
 
 
 def monodromy(model, steps: Optional[int] = 2000) -> np.ndarray:

@@ -380,6 +380,22 @@ def _branch_color(k: int) -> str:
     return "0.15" if k == 0 else f"C{(2 * abs(k) + (k < 0)) % 10}"
 
 
+def _branch_bands(ax, res, lines, order, scale, level: float = 0.95):
+    """The branches' 95 % magnitude bands at the excited lines (res.htf_band, METHOD.md section 22),
+    shaded; nothing without a covariance."""
+    if getattr(res, "covariance", None) is None or not hasattr(res, "htf_band"):
+        return
+    try:
+        band = res.htf_band(lines=lines[lines > 0], branches=order, level=level)
+    except (ValueError, np.linalg.LinAlgError):
+        return
+    mb = band.magnitude_band()
+    for i, k in enumerate(band.branches):
+        ax.fill_between(band.w * scale, _db(np.maximum(mb[i, :, 0], 1e-2 * np.abs(band.G[i]))), _db(mb[i, :, 1]),
+                        color=_branch_color(int(k)), alpha=0.25, lw=0,
+                        label=f"model {100 * level:g} % band" if i == 0 else None)
+
+
 def _branches_panel(ax, res, sets, scale, n_points):
     """The model's HTF branches over the excited band and, where the record determines them, their
     nonparametric estimates (lptv.htf_estimate) with +-2 std."""
@@ -396,6 +412,7 @@ def _branches_panel(ax, res, sets, scale, n_points):
     for k in order:
         ax.plot(w * scale, _db(model.freqresp(w, branch=k)), "-", lw=1.2, color=_branch_color(k),
                 label=f"G_{k:+d}" if k else "G_0")
+    _branch_bands(ax, res, np.unique(lines), order, scale)
     why = []
     drawn = False
     for i, (_, d, rows) in enumerate(sets):

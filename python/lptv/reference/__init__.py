@@ -15,11 +15,13 @@ It reads a model's coefficient arrays and never calls the core's computations.
   :func:`lptv.moderated_noise` (SciPy's polygamma and F quantile, NumPy's window sums);
 - :mod:`lptv.reference.mimo`: the block band matrices of a matrix model (several inputs and
   outputs) and the dense solve behind :func:`lptv.simulate` on a :class:`lptv.MimoModel`;
+- :mod:`lptv.reference.floquet`: the monodromy matrix by solve_ivp (the product in discrete time)
+  and the exponents' derivative by central differences (METHOD.md section 22);
 - :mod:`lptv.reference.record`: one record with its transient behind
   :func:`lptv.identify_record` (equation-error start, SciPy's Levenberg-Marquardt on the output
   error, dense LU per residue class of the record's lines, the residual's noise level).
 """
-from . import distortion, excitation, identification, likelihood, mimo, moderation, record
+from . import distortion, excitation, floquet, identification, likelihood, mimo, moderation, record
 from .fds import (
     band_matrix_A,
     band_matrix_B,
@@ -37,7 +39,7 @@ from .fds import (
 )
 
 __all__ = [
-    "distortion", "excitation", "identification", "likelihood", "mimo", "moderation", "record", "band_matrix_A", "band_matrix_B", "coefficients_at",
+    "distortion", "excitation", "floquet", "identification", "likelihood", "mimo", "moderation", "record", "band_matrix_A", "band_matrix_B", "coefficients_at",
     "crest_factor", "full_spectrum", "grid", "htf", "line_variable", "multisine_spectrum",
     "samples_per_period", "simulate", "spectrum", "time_signal",
 ]
