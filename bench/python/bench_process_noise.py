@@ -29,7 +29,7 @@ import process_rig as pr  # noqa: E402  (tests/python/process_rig.py: the rig by
 
 import lptv  # noqa: E402
 
-ROUTES = ("sample", "full", "auto")
+ROUTES = ("sample", "full", "full-rows", "auto")
 METHODS = ("wgtls", "sml")
 
 

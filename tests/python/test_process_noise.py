@@ -151,6 +151,8 @@ def test_full_route_errors_name_what_is_wrong():
         correlated_lines(given)
     with pytest.raises(ValueError, match="noise must be one of"):
         lptv.identify(u, y, na=1, nb=0, w0=1.0, noise="record")
+    with pytest.raises(ValueError, match="full-rows.*one input and one output"):
+        lptv.identify(u[:, :, None], y[:, :, None], na=1, nb=0, w0=1.0, noise="full-rows")
     with pytest.raises(ValueError, match="noise='full-moderated' is not for covariance='bootstrap'"):
         lptv.identify(u, y, na=1, nb=0, w0=1.0, noise="full-moderated", covariance="bootstrap")
     # data given without the periods: noise='auto' stays on the given statistics
@@ -236,7 +238,8 @@ def test_the_rows_noise_from_the_realisations_against_the_record_s_bins(loop):
     rec = rig.records([21], periods=8, loop=loop, process=5.0)[0]
     u, y = rec["u"], rec["y"]
     d = lptv.FrequencyData.from_periods(u, y, w0=rig.W0, statistics="record")
-    res = fit(rec, method="wgtls", noise="full")
+    res = fit(rec, method="wgtls", noise="full-rows")
+    assert res.noise == "full-rows"
     K = 1
     rows = [int(l) for l in rig.fit_lines()]
     par = _core.Parametrisation(_core.Structure(2, 0, [1, 0, 0], [0], [], rig.W0, 0.0))

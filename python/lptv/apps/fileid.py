@@ -120,12 +120,13 @@ def add_parser(sub):
                    "(intervals that include the nonlinear distortion's correlation across lines)")
     p.add_argument("--bootstrap", type=int, default=200, metavar="B",
                    help="refits for --covariance bootstrap (default 200)")
-    p.add_argument("--noise", default="auto", choices=("auto", "sample", "moderated", "full", "full-moderated"),
+    p.add_argument("--noise", default="auto", choices=("auto", "sample", "moderated", "full", "full-moderated", "full-rows"),
                    help="the noise variances the fit weighs by: each line's own from its periods (sample), "
                    "or moderated across neighbouring lines (smooth noise spectra; more precise estimates and "
                    "calibrated intervals at few periods); full, full-moderated: the same from the whole "
                    "record's bins between the lines (a disturbance that passes through the system, or a "
-                   "loop under feedback); auto (default): the record's when the periods' noise is "
+                   "loop under feedback), full-rows: full with each row read on the record's noise "
+                   "realisations; auto (default): the record's when the periods' noise is "
                    "correlated between neighbouring lines, moderated when the noise spectrum passes a "
                    "smoothness check; the summary says which and why")
     p.add_argument("--referred", default="auto", choices=("auto", "output", "input", "none"),

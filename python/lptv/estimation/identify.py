@@ -16,7 +16,7 @@ from .mimo_identify import identify_mimo, is_mimo
 from ..judgement.result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
-NOISES = ("auto", "sample", "moderated", "full", "full-moderated")
+NOISES = ("auto", "sample", "moderated", "full", "full-moderated", "full-rows")
 # noise='auto' moderates from this many periods: below it the lines that keep their own variance
 # (lines 0 and Lmax, outliers) have 1-4 degrees of freedom, and the checks that read the moderated
 # data's periods for every line (the input's presence, the rows with signal) would misjudge them.
@@ -188,7 +188,10 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         :meth:`FrequencyData.record_statistics`), right also for a disturbance that passes
         through the system or does not repeat in the periods (its response leaks into every
         period, and the periods' statistics count that leakage, which the mean does not hold);
-        they need the periods (not FrequencyData made otherwise). 'moderated': each line's combined with its neighbours' by
+        they need the periods (not FrequencyData made otherwise). 'full-rows': 'full' with each
+        row read on the record's realisations of the noise (the terms between a row's lines
+        and between input and output; one input and output; measured, not the default:
+        METHOD.md section 20). 'moderated': each line's combined with its neighbours' by
         :func:`lptv.moderated_noise` (empirical Bayes, METHOD.md section 7), worth about
         1 + nu / 2 periods (nu the lines' median degrees of freedom, often 40-120 at P = 4 when
         the noise spectrum is smooth); the covariance's small-sample factor is taken at those
@@ -293,7 +296,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ts = data.ts if ts is None else ts
     moderation = ()
     choice = "asked for"
-    if noise in ("full", "full-moderated"):
+    if noise in ("full", "full-moderated", "full-rows"):
         if several:
             datas = [_record_data(d, f"experiments[{i}]") for i, d in enumerate(datas)]
             data = datas[0]
@@ -322,8 +325,8 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
     ka_l, kb_l = _counts(ka, na, "ka"), _counts(kb, nb, "kb")
     kn = _known_list(known, ka_l, kb_l)
     structure = _core.Structure(na, nb, ka_l, kb_l, kn, data.w0, 0.0 if ts is None else float(ts))
-    # the record's routes read each row on the noise's realisations (METHOD.md section 20)
-    full_rows = noise in ("full", "full-moderated")
+    # noise='full-rows' reads each row on the noise's realisations (METHOD.md section 20)
+    full_rows = noise == "full-rows"
     if several:
         rows = _experiment_rows(datas, lines, max(ka_l + kb_l))
         try:

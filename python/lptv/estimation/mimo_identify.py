@@ -183,6 +183,9 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
                   noise="auto") -> MimoIdentificationResult:
     """lptv.identify's route for several inputs or outputs (its docstring has the arguments)."""
     noises = ("auto", "sample", "moderated", "full", "full-moderated")
+    if noise == "full-rows":
+        raise ValueError("noise='full-rows' reads the rows on the record's realisations for one input and one "
+                         "output only: use noise='full' for several channels")
     if not isinstance(noise, str) or noise not in noises:
         raise ValueError(f"noise must be one of {noises}, got {noise!r}")
     if not isinstance(method, str) or method not in MIMO_METHODS:

@@ -452,7 +452,7 @@ class IdentificationResult:
         lines = [
             f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} lines",
         ]
-        if self.noise in ("full", "full-moderated"):
+        if self.noise in ("full", "full-moderated", "full-rows"):
             lines.append("noise: from the whole record's bins between the lines (a disturbance that passes "
                          "through the system, METHOD.md section 20)")
         if self.noise in ("moderated", "full-moderated"):

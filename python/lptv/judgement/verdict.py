@@ -177,7 +177,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         if fitted is not None:        # the fit weighed by moderated variances: d holds them
             mo, nu_line = fitted, fitted.dof
             d = mo.unbiased_data()
-        elif MODERATE and P >= 2 and res.noise in ("sample", "full"):
+        elif MODERATE and P >= 2 and res.noise in ("sample", "full", "full-rows"):
             from ..spectra.moderation import moderated_noise, smooth_noise
             mo = moderated_noise(d)
             # only a smooth noise spectrum (the check of identify's noise='auto'): bumps a few
@@ -194,7 +194,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
         # the record's routes: each row's variance from the noise's realisations (METHOD.md
         # section 20), S = D S_line D with D from the data the fit weighed by
         scale = None
-        if res.noise in ("full", "full-moderated") and _core.has_row_noise(d_fit._cpp):
+        if res.noise == "full-rows" and _core.has_row_noise(d_fit._cpp):
             scale = np.asarray(_core.row_noise_scale(d_fit._cpp, par, [int(x) for x in keep], theta))
             like.set_row_scale(scale)
         srt = np.asarray(like.sorted_rows)
