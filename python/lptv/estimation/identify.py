@@ -21,10 +21,9 @@ NOISES = ("auto", "sample", "moderated", "full", "full-moderated", "full-rows")
 # (lines 0 and Lmax, outliers) have 1-4 degrees of freedom, and the checks that read the moderated
 # data's periods for every line (the input's presence, the rows with signal) would misjudge them.
 AUTO_MIN_PERIODS = 4
-# noise='auto' on the record's statistics moderates from this many periods: at P = 4 the rows'
-# realisations (2 (P - 1) = 6 degrees of freedom each) make the moderated fits' intervals cover
-# 85-92 % on bench_process_noise.py's rig, the record's sample variances 97.6-99.4 %
-# (METHOD.md section 20)
+# noise='auto' on the record's statistics moderates from this many periods: at P = 4 the moderated
+# fits' SML intervals covered 90.8-93.7 % on bench_process_noise.py's rig, the record's sample
+# variances 98.8-99.3 % (METHOD.md section 20)
 AUTO_MIN_PERIODS_RECORD = 8
 COVARIANCES = ("analytic", "bootstrap", "realisations", "none")
 
@@ -482,7 +481,7 @@ def _auto_noise(datas, covariance):
         if full and d.periods < AUTO_MIN_PERIODS_RECORD:
             return sample, say("the sample variances", (
                 f"{d.periods} periods (on the record's noise the moderated route needs {AUTO_MIN_PERIODS_RECORD}: "
-                f"each row's terms between lines come from {d.periods - 1} realisations)")), None
+                f"with fewer its intervals are too narrow)")), None
         if d.periods < AUTO_MIN_PERIODS:
             return sample, say("the sample variances", (
                 f"{d.periods} periods (the moderated route needs {AUTO_MIN_PERIODS}: the lines that keep "
