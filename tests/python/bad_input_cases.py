@@ -1158,6 +1158,7 @@ def cli_cases():
     add("identify-scheduler-not-an-address", ok + ("--scheduler", "not an address"), "(scheduler|executor|dask)")
     add("identify-unknown-option", ok + ("--nope", "1"), "--nope")
     add("identify-input-missing", ok + ("--input", "force"), "--input")
+    add("identify-reference-missing", ok + ("--reference", "r"), "--reference")
     add("identify-output-missing", ok + ("--output", "disp"), "--output")
     add("identify-output-two", ok + ("--output", "y,u"), "--output")
     add("identify-outputs-missing", ok + ("--output", "y,force"), "--output")

@@ -280,3 +280,27 @@ def coefficient_rows(par, theta, K):
     kb = m.b.shape[1] // 2
     b[:, K - kb:K + kb + 1] = m.b
     return a, b
+
+
+def test_identify_reads_the_period_from_a_reference_column(tmp_path, capsys):
+    """Under feedback the input holds the loop's response to the disturbance: the period check on
+    the input takes 8 s for the rig's 4 s here; --reference reads it from the recorded reference."""
+    from lptv.apps import cli
+
+    rec = rig.records([7], periods=16, loop="feedback", process=5.0, skip=0)[0]
+    u, y = rec["u"].ravel(), rec["y"].ravel()
+    t = np.arange(u.size) / rig.FS
+    lines, amp, ph = rig.reference(0)
+    r = np.cos(np.outer(t, lines * rig.W0) + ph) @ amp
+    path = tmp_path / "loop.csv"
+    np.savetxt(path, np.c_[t, r, u, y], delimiter=",", comments="",
+               header="time [s],reference [N],force [N],displacement [m]")
+    args = [str(path), "--input", "force", "--output", "displacement", "--period", "4", "--skip-periods", "6",
+            "--lines", "excited", "--na", "2", "--nb", "0", "--ka", "1,0,0", "--kb", "0", "--no-report"]
+    rc = cli.main(["identify", *args, "--out", str(tmp_path / "a")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "use --period 8" in err
+    rc = cli.main(["identify", *args, "--reference", "reference", "--out", str(tmp_path / "b")])
+    out = capsys.readouterr().out
+    assert rc == 0, out
+    assert "the model is consistent with the noise" in out and "from the whole record" in out

@@ -144,6 +144,10 @@ def add_parser(sub):
                    help="fit the record as the options cut it even where the record says otherwise (a period "
                    "or --fs that contradicts the one found in the data, a record that does not repeat); "
                    "the contradiction is then printed as a warning")
+    p.add_argument("--reference", metavar="NAME",
+                   help="a recorded reference column (the loop's external periodic excitation under "
+                   "feedback): the period check reads where it repeats, not the input, which under "
+                   "feedback holds the loop's response to its disturbance (guide page 14)")
     p.add_argument("--known", metavar="a2=1.5,b0=1", help="coefficients known to be constant")
     p.add_argument("--scale", metavar="b0=1",
                    help="report the parameters in physical form: all scaled so that the mean of this "
@@ -184,6 +188,10 @@ def run(args) -> int:
     from lptv.apps import mimoid
 
     if mimoid.several_channels(args):      # --input f1,f2 / --output x1,x2: one fit of all the files
+        if getattr(args, "reference", None):
+            print("lptv identify: error: --reference: the period check by a reference column is built for one "
+                  "input and one output (several channels: --no-period-check with --period)", file=sys.stderr)
+            return 2
         return mimoid.run(args)
     if args.covariance != "analytic" and (args.joint or len(args.files) > 1 or args.workers is not None
                                           or args.scheduler is not None):

@@ -147,10 +147,15 @@ def period_option(args):
 
 def diagnose(src, args):
     """:func:`lptv.inspect` on the file as the options name its channels and fs; None when the
-    file cannot be read that way (the reader's own error then stands)."""
+    file cannot be read that way (the reader's own error then stands). With ``--reference NAME``
+    (lptv identify) the period is read where the reference repeats, not the input: under
+    feedback the input holds the loop's response to its disturbance (METHOD.md section 20)."""
+    reference = getattr(args, "reference", None)
     try:
-        return inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt)
-    except (ValueError, OSError):
+        return inspect(src, u=reference or args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt)
+    except (ValueError, OSError) as e:
+        if reference:
+            raise FileError(f"--reference {reference}: {' '.join(str(e).split())}") from None
         return None
 
 
