@@ -1180,6 +1180,8 @@ def cli_cases():
         add(f"inspect-reach-{v}", ins + ("--reach", v), "--reach")
     add("inspect-input-missing", ins + ("--input", "force"), "--input")
     add("inspect-output-missing", ins + ("--output", "disp"), "--output")
+    add("inspect-reference-missing", ins + ("--reference", "r"), "--reference")
+    add("inspect-reference-two-inputs", ins + ("--input", "u,y", "--reference", "u"), "--reference")
     add("inspect-time-missing", ins + ("--time", "clock"), "--time")
     add("inspect-out-proc", ins[:2] + ("--out", "/proc/nope"), "/proc/nope")
     add("inspect-unknown-option", ins + ("--nope", "1"), "--nope")

@@ -282,12 +282,8 @@ def coefficient_rows(par, theta, K):
     return a, b
 
 
-def test_identify_reads_the_period_from_a_reference_column(tmp_path, capsys):
-    """Under feedback the input holds the loop's response to the disturbance: the period check on
-    the input takes 8 s for the rig's 4 s here; --reference reads it from the recorded reference."""
-    from lptv.apps import cli
-
-    rec = rig.records([7], periods=16, loop="feedback", process=5.0, skip=0)[0]
+def _loop_csv(tmp_path, seed=7):
+    rec = rig.records([seed], periods=16, loop="feedback", process=5.0, skip=0)[0]
     u, y = rec["u"].ravel(), rec["y"].ravel()
     t = np.arange(u.size) / rig.FS
     lines, amp, ph = rig.reference(0)
@@ -295,12 +291,85 @@ def test_identify_reads_the_period_from_a_reference_column(tmp_path, capsys):
     path = tmp_path / "loop.csv"
     np.savetxt(path, np.c_[t, r, u, y], delimiter=",", comments="",
                header="time [s],reference [N],force [N],displacement [m]")
+    return path, (r, u, y)
+
+
+def test_identify_reads_the_period_of_a_closed_loop_file(tmp_path, capsys):
+    """Under feedback the input holds the loop's response to the disturbance, which repeats better
+    at twice the period than white noise's deviations allow (section 18's rule (a) took 8 s for
+    the rig's 4 s here before the multiple had to show lines off the period's grid): the period
+    check accepts --period 4 from the input alone, and from a recorded reference column."""
+    from lptv.apps import cli
+
+    path, _ = _loop_csv(tmp_path)
     args = [str(path), "--input", "force", "--output", "displacement", "--period", "4", "--skip-periods", "6",
             "--lines", "excited", "--na", "2", "--nb", "0", "--ka", "1,0,0", "--kb", "0", "--no-report"]
-    rc = cli.main(["identify", *args, "--out", str(tmp_path / "a")])
-    err = capsys.readouterr().err
-    assert rc == 2 and "use --period 8" in err
-    rc = cli.main(["identify", *args, "--reference", "reference", "--out", str(tmp_path / "b")])
+    for extra, name in (((), "a"), (("--reference", "reference"), "b")):
+        rc = cli.main(["identify", *args, *extra, "--out", str(tmp_path / name)])
+        out = capsys.readouterr().out
+        assert rc == 0, out
+        assert "the model is consistent with the noise" in out and "from the whole record" in out
+
+
+
+def test_inspect_reads_the_period_from_a_reference_column(tmp_path, capsys):
+    """lptv inspect on the closed-loop record: --reference reads the period where the reference
+    repeats, judges the rest on the input, and suggests a command that carries --reference,
+    which fits the true structure as consistent; the input alone reads the same 4 s."""
+    import shlex
+
+    from lptv.apps import cli
+
+    path, (r, u, y) = _loop_csv(tmp_path)
+    base = ["inspect", str(path), "--input", "force", "--output", "displacement"]
+    assert cli.main([*base, "--out", str(tmp_path / "i0")]) == 0
     out = capsys.readouterr().out
-    assert rc == 0, out
-    assert "the model is consistent with the noise" in out and "from the whole record" in out
+    assert "--period 4 " in out, out
+    assert cli.main([*base, "--reference", "reference", "--out", str(tmp_path / "i1")]) == 0
+    out = capsys.readouterr().out
+    assert "reference 'reference [N]'" in out and "repeats every 4.00 s" in out, out
+    assert "under feedback" in out
+    cmd = next(ln for ln in out.splitlines() if ln.startswith("suggested:")).split(":", 1)[1].split()
+    assert "--period" in cmd and cmd[cmd.index("--period") + 1] == "4"
+    assert " ".join(cmd[cmd.index("--reference") + 1:][:2]) == "'reference [N]'"
+    # the same in Python, from the samples: the period of the reference, the excitation of the input
+    fs = rig.FS
+    a = lptv.inspect(u=u, y=y, fs=fs)
+    b = lptv.inspect(u=u, y=y, fs=fs, reference=r)
+    assert a.period == pytest.approx(4.0) and b.period == pytest.approx(4.0)
+    assert b.reference == "reference" and b.input_repeat_ratio > b.repeat_ratio
+    assert b.transient_periods >= 1 and set(rig.reference(0)[0]) <= set(b.lines.tolist())
+    # the suggested command, with the orders filled in, fits the true structure as consistent
+    line = " ".join(cmd).replace("NA", "2").replace("NB", "0")
+    args = shlex.split(line)[2:]
+    ka = args.index("--ka")
+    args[ka + 1:ka + 2] = ["1,0,0"]
+    kb = args.index("--kb")
+    args[kb + 1] = "0"
+    rc = cli.main(["identify", *args, "--no-report", "--out", str(tmp_path / "fit")])
+    out = capsys.readouterr().out
+    assert rc == 0 and "the model is consistent with the noise" in out, out
+
+
+def test_inspect_reference_refusals(tmp_path):
+    path, (r, u, y) = _loop_csv(tmp_path)
+    with pytest.raises(ValueError, match="reference"):
+        lptv.inspect(path, u="force", y="displacement", reference="nope")
+    with pytest.raises(ValueError, match="reference must have as many samples"):
+        lptv.inspect(u=u, y=y, fs=rig.FS, reference=r[:-3])
+    with pytest.raises(ValueError, match="reference.*constant"):
+        lptv.inspect(u=u, y=y, fs=rig.FS, reference=np.ones_like(r))
+    with pytest.raises(ValueError, match="reference must be the name"):
+        lptv.inspect(path, u="force", y="displacement", reference=r)
+
+
+@pytest.mark.parametrize("seed", range(5))
+@pytest.mark.parametrize("skip", [0, 8])
+def test_the_period_of_a_closed_loop_record_from_its_input(seed, skip):
+    """The input of the closed-loop rig repeats every 4 s; its non-repeating part, the loop's
+    coloured response to the disturbance, repeated better at 8 s than white noise allows in 3 of
+    these 5 records (and the output at 8, 12 or 20 s): a multiple is the period only where it
+    shows lines off the shorter period's grid above their own noise."""
+    rec = rig.records([seed], periods=16, loop="feedback", process=5.0, skip=skip)[0]
+    r = lptv.inspect(u=rec["u"].ravel(), y=rec["y"].ravel(), fs=rig.FS)
+    assert r.input_period_samples == 4 * rig.FS and r.period == pytest.approx(4.0)

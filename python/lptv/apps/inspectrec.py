@@ -14,6 +14,7 @@ that does not repeat, an output that does not repeat with the input.
 Example::
 
     lptv inspect rig.csv --input force --output displacement
+    lptv inspect loop.csv --input force --output displacement --reference reference   (under feedback)
     lptv inspect exp0.csv --input f1,f2 --output x1,x2     (several channels: lptv.apps.inspectmimo)
 """
 from __future__ import annotations
@@ -58,6 +59,9 @@ def add_parser(sub):
     g = p.add_mutually_exclusive_group()
     g.add_argument("--fs", type=float, help="sampling frequency in Hz (default: the file's)")
     g.add_argument("--dt", type=float, help="sampling time in s")
+    p.add_argument("--reference", metavar="NAME",
+                   help="read the period where this column repeats (the loop's external periodic reference of a "
+                        "record under feedback, where the input also holds the loop's response to the disturbance)")
     p.add_argument("--reach", type=int, metavar="K",
                    help="count sidebands up to +-K lines from an excited line (default: the room the design leaves)")
     p.add_argument("--out", help="output folder (default: <file stem>-inspect/)")
@@ -77,11 +81,17 @@ def run(args) -> int:
     except OSError as e:
         return _fail(e.filename or args.out, e.strerror or e)
     if any(v is not None and "," in v for v in (args.input, args.output)):
+        if args.reference:
+            return _fail("--reference", "the period read from a reference column is built for one input and one "
+                                        "output; give --period to lptv identify for several channels")
         from lptv.apps import inspectmimo
         return inspectmimo.run(args, summary, report, _fail)
     try:
-        insp = inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt, reach=args.reach)
+        insp = inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt, reach=args.reach,
+                       reference=args.reference)
     except ValueError as e:
+        if args.reference and str(e).startswith("reference"):
+            return _fail(f"--reference {args.reference}", str(e).partition(": ")[2] or e)
         return _fail(src, e)
     print(insp.summary())
     out = Path(args.out) if args.out else Path(Path(src).stem + "-inspect")
@@ -102,6 +112,7 @@ def summary(insp) -> dict:
     """The findings as plain values (summary.json)."""
     return {
         "file": insp.source, "format": insp.format, "input": insp.input, "output": insp.output,
+        "reference": insp.reference, "input_repeat_ratio": None if insp.reference is None else insp.input_repeat_ratio,
         "samples": insp.samples, "fs": insp.fs, "fs_source": insp.fs_source, "file_fs": insp.file_fs,
         "repeats": insp.repeats, "input_period_samples": insp.input_period_samples,
         "period_samples": insp.period_samples, "input_period_exact_samples": insp.input_period_exact, "period": insp.period,
@@ -152,9 +163,9 @@ def diagnose(src, args):
     feedback the input holds the loop's response to its disturbance (METHOD.md section 20)."""
     reference = getattr(args, "reference", None)
     try:
-        return inspect(src, u=reference or args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt)
+        return inspect(src, u=args.input, y=args.output, time=args.time, fs=args.fs, dt=args.dt, reference=reference)
     except (ValueError, OSError) as e:
-        if reference:
+        if reference and "reference" in str(e):
             raise FileError(f"--reference {reference}: {' '.join(str(e).split())}") from None
         return None
 

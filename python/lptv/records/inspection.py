@@ -113,6 +113,12 @@ class Inspection:
     stored_period: Optional[int]
     """Samples per row of a (P, N) array in the file, None for a long record."""
     notes: Tuple[str, ...]
+    reference: Optional[str] = None
+    """The channel the period was read from when it is not the input (``reference=``): the
+    loop's external periodic excitation of a record taken under feedback."""
+    input_repeat_ratio: float = math.nan
+    """With a reference: r of the input at the reference's period (under feedback the share of
+    its power that is the loop's response to the disturbance, plus its noise)."""
 
     # ------------------------------------------------------------------ derived
 
@@ -184,6 +190,8 @@ class Inspection:
             cmd += ["--input", shlex.quote(self.input)]
         if self.output != "y":
             cmd += ["--output", shlex.quote(self.output)]
+        if self.reference is not None and self.format != "arrays":
+            cmd += ["--reference", shlex.quote(self.reference)]
         if self.fs is not None:
             if self.fs_given:
                 cmd += ["--fs", f"{self.fs:.12g}"]
@@ -203,15 +211,16 @@ class Inspection:
     def summary(self) -> str:
         """What the record holds, one finding a line, ending with the suggested command."""
         out = [f"lptv inspect: {self.source} ({self.format}, {self.samples} samples; input '{self.input}', "
-               f"output '{self.output}')"]
+               f"output '{self.output}'" + (f", reference '{self.reference}'" if self.reference else "") + ")"]
         if self.fs is None:
             out.append("sampling:    fs unknown (no time column or stored fs; give --fs): periods in samples")
         else:
             src = "given" if self.fs_given else f"from {self.fs_source}" + (
                 ", uniform" if "column" in (self.fs_source or "") or "'t" in (self.fs_source or "") else "")
             out.append(f"sampling:    fs = {self.fs:g} Hz ({src})")
+        what = f"the reference '{self.reference}'" if self.reference else "the input"
         if not self.repeats:
-            out.append(f"period:      none: the input does not repeat at any lag up to "
+            out.append(f"period:      none: {what} does not repeat at any lag up to "
                        f"{self.seconds(self.max_period_samples, 'half the record')}"
                        f"; the best lag leaves {100 * min(self.repeat_ratio, 9.99):.3g} % of its power unexplained")
             out.append("route:       not a periodic record: identify it as one record with its transient, "
@@ -221,8 +230,11 @@ class Inspection:
             out += [f"note:        {n}" for n in self.notes]
             return "\n".join(out)
         N, L = self.period_samples, self.input_period_samples
-        out.append(f"period:      the input repeats every {self.seconds(L)}; "
+        out.append(f"period:      {what} repeats every {self.seconds(L)}; "
                    f"{100 * self.repeat_ratio:.2g} % of its power does not repeat (its noise)")
+        if self.reference:
+            out.append(f"             the input: {100 * min(self.input_repeat_ratio, 9.99):.2g} % of its power does not "
+                       "repeat at that period (under feedback: the loop's response to its disturbance, and its noise)")
         if N != L:
             out.append(f"             the output repeats only every {N // L} of them: period {self.seconds(N)}")
         elif not self.output_repeats:
@@ -390,7 +402,7 @@ def _raw_record(path, u, y, time, fs_given):
 
 
 def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None, dt: Optional[float] = None,
-            reach: Optional[int] = None) -> Inspection:
+            reach: Optional[int] = None, reference=None) -> Inspection:
     """Look at a record before fitting a model: its sampling, period, periods, transient,
     excitation and the output's power between the excited lines.
 
@@ -412,6 +424,12 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         Sidebands are counted up to +-reach lines from an excited line (default: what the
         excitation's grid leaves between its lines, (s - 1) // 2 for excited lines on multiples
         of s, at least 1).
+    reference : str or array_like, optional
+        Read the period where this channel repeats instead of the input (with ``path`` its
+        name, else its samples): the loop's external periodic excitation of a record taken under
+        feedback, where the input also holds the loop's response to the disturbance, which does
+        not repeat and can make the input's repeat residue lowest at a multiple of the period
+        (METHOD.md section 20). The rest (excitation, transient, lines) is judged on the input.
 
     Returns
     -------
@@ -449,6 +467,14 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         p = Path(as_path(path))
         uu, yy, names, fmt, found, stored, kind = _raw_record(p, u, y, time, fs_in is not None)
         source, what = str(path), f"{kind} '{names[0]}'"
+        if reference is not None:
+            if not isinstance(reference, str):
+                raise ValueError(f"reference must be the name of a channel of the file, got {type(reference).__name__}")
+            try:
+                rr, _, rnames, *_ = _raw_record(p, reference, y, time, fs_in is not None)
+            except FileError as e:
+                raise FileError(f"reference: {e}") from None
+            ref_name = rnames[0]
     else:
         for name, v in (("u", u), ("y", y)):
             if v is None:
@@ -464,6 +490,17 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         if uu.size != yy.size:
             raise ValueError(f"u and y must have as many samples, got {uu.size} and {yy.size}")
         names, fmt, found, source, what = ("u", "y"), "arrays", None, "arrays", "the input"
+        if reference is not None:
+            rr = _array(reference, "reference")
+            if rr.dtype.kind == "c" or rr.ndim > 2:
+                raise ValueError("reference must be a real record (1-D, or periods x samples), got "
+                                 f"{'complex values' if rr.dtype.kind == 'c' else f'shape {rr.shape}'}")
+            rr = rr.astype(float).ravel()
+            if rr.size != uu.size:
+                raise ValueError(f"reference must have as many samples as u, got {rr.size} and {uu.size}")
+            ref_name = "reference"
+    if reference is None:
+        rr, ref_name = uu, None
     for name, v in zip(names, (uu, yy)):
         bad = np.flatnonzero(~np.isfinite(v))
         if bad.size:
@@ -473,10 +510,16 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
     if np.ptp(uu) == 0:
         raise FileError(f"{what} (the input) is constant: a dead or disconnected input channel; nothing excites "
                         "the system")
+    if ref_name is not None:
+        bad = np.flatnonzero(~np.isfinite(rr))
+        if bad.size:
+            raise FileError(f"the reference '{ref_name}' contains NaN or inf (sample {bad[0] + 1})")
+        if np.ptp(rr) == 0:
+            raise FileError(f"the reference '{ref_name}' is constant: it cannot show the period")
     file_fs, file_src = found if found is not None else (None, None)
     fs_used, fs_src = (fs_in, None) if fs_in is not None else (file_fs, file_src)
     n = uu.size
-    L, Lf, r = find_period(uu)
+    L, Lf, r = find_period(rr)
     lags = np.arange(r.size)
     notes = []
     if fs_in is not None and file_fs is not None and not np.isclose(fs_in, file_fs, rtol=1e-6, atol=0):
@@ -485,7 +528,7 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         notes.append(f"the output '{names[1]}' is constant: a dead output channel (or a sensor stuck at one value)")
     common = dict(source=source, format=fmt, input=names[0], output=names[1], samples=n, fs=fs_used,
                   fs_source=fs_src, file_fs=file_fs, file_fs_source=file_src, fs_given=fs_in is not None,
-                  lags=lags, repeat=r, stored_period=stored)
+                  lags=lags, repeat=r, stored_period=stored, reference=ref_name)
     if L is None:
         lo = np.flatnonzero(r[1:] >= 1.0)
         rr = float(np.min(r[lo[0] + 1:])) if lo.size and lo[0] + 1 < r.size else float(np.min(r[1:])) if r.size > 1 else 1.0
@@ -565,7 +608,9 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         snr_u = 10 * np.log10(zu[excited - 1]) if excited.size else np.zeros(0)
         snr_y = 10 * np.log10(zy[excited - 1]) if excited.size else np.zeros(0)
     return Inspection(**common, repeats=True, input_period_samples=L, input_period_exact=Lf, period_samples=N,
-                      repeat_ratio=_residue_at(uu, L), output_repeats=bool(r_y <= OUTPUT_REPEAT_LIMIT),
+                      repeat_ratio=_residue_at(rr, L),
+                      input_repeat_ratio=_residue_at(uu, L) if ref_name is not None else math.nan,
+                      output_repeats=bool(r_y <= OUTPUT_REPEAT_LIMIT),
                       output_repeat_ratio=float(r_y), periods=P, leftover=left, transient_ratios=ratios,
                       transient_limit=float(limit), transient_periods=skip, transient=tr, lines=excited, spacing=s,
                       weak_input_lines=weak, input_snr_db=snr_u, output_snr_db=snr_y, reach=K, classes=classes,

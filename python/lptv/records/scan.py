@@ -112,8 +112,10 @@ def find_period(x, max_lag=None):
 
     Lags start after r first reaches 1 (the correlation of neighbouring samples no longer holds
     x together). A candidate is a local minimum of r below REPEAT_LIMIT such that (a) none of its
-    multiples repeats better by more than SIGMAS noise deviations (else it is a near repeat, a
-    signal with little power on the lines that tell it from the period), (b) its multiples
+    multiples repeats better by more than SIGMAS noise deviations and shows lines off the
+    candidate's grid above their own noise (else it is a near repeat, a signal with little power
+    on the lines that tell it from the period; without such lines the better repeat is coloured
+    noise, the loop's response to a disturbance under feedback), (b) its multiples
     repeat as well as it does on the record without its first quarter (a narrow band of noise
     drifts away), (c) refined between samples it is whole to within WHOLE. The shortest
     candidate is the period; without a whole one the shortest that meets (a) and (b)."""
@@ -146,8 +148,10 @@ def find_period(x, max_lag=None):
         Lf = _refine(x[start:], L) if n - start > L + 1 else _refine(x, L)
         mult = _multiples(r, Lf, max_lag)
         r_L = float(r[L])
-        if mult.size and r_L > _bound(float(np.min(r[mult])), n, int(mult[np.argmin(r[mult])]), L):
-            continue                                                      # (a)
+        if mult.size:
+            M = int(mult[np.argmin(r[mult])])
+            if r_L > _bound(float(r[M]), n, M, L) and _off_grid_lines(x[start:], M, max(2, round(M / Lf))):
+                continue                                                  # (a)
         if not _multiples_repeat(tail, Lf, n - start):
             continue                                                      # (b)
         if abs(Lf - L) <= WHOLE:
@@ -223,12 +227,14 @@ def _off_grid_lines(y, N, m):
     if P < 2:
         return False
     lines, Y, var = _spectra(y[y.size - P * N:].reshape(P, N))
-    noise, nu = _pooled(var, P)
     off = lines % m != 0
     p2 = np.abs(Y) ** 2
+    # each line against its own variance over the periods (|Y|^2 / (var / P) ~ F(2, 2 (P - 1))
+    # for noise): a coloured noise, the loop's response to a disturbance at a resonance, lies
+    # above a median pooled over neighbouring lines on the resonance's lines
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = np.where(p2 > 1e-20 * p2.max(), p2 / (noise / P), 0.0)[off]
-    return bool(np.any(z > _threshold(int(off.sum()), nu)))
+        z = np.where(p2 > 1e-20 * p2.max(), p2 / (var / P), 0.0)[off]
+    return bool(np.any(z > _threshold(int(off.sum()), P - 1)))
 
 
 # ------------------------------------------------------------------------------ the periods
