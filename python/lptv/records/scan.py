@@ -17,6 +17,8 @@ be a repeat (METHOD.md section 18)."""
 ALPHA = 0.01
 """The chance that noise alone puts any line of the record above the line test's threshold."""
 NOISE_HALF_WINDOW = 20
+OWN_LEVEL = 0.01
+OWN_HALF_WINDOW = 2
 """Lines on each side pooled into a line's noise level (their median)."""
 WHOLE = 0.1
 """A period refined to within this of a whole number of samples is whole (measured: within 0.05
@@ -148,10 +150,12 @@ def find_period(x, max_lag=None):
         Lf = _refine(x[start:], L) if n - start > L + 1 else _refine(x, L)
         mult = _multiples(r, Lf, max_lag)
         r_L = float(r[L])
-        if mult.size:
-            M = int(mult[np.argmin(r[mult])])
-            if r_L > _bound(float(r[M]), n, M, L) and _off_grid_lines(x[start:], M, max(2, round(M / Lf))):
-                continue                                                  # (a)
+        beaten = [int(M) for M in mult if r_L > _bound(float(r[M]), n, int(M), L)]
+        # a multiple that leaves fewer than 3 of its periods past the first quarter cannot show
+        # its lines above a coloured noise (2 degrees of freedom a line): judged at those it can
+        judged = [M for M in beaten if (n - start) // M >= 3]
+        if any(_off_grid_lines(x[start:], M, max(2, round(M / Lf))) for M in judged):
+            continue                                                      # (a)
         if not _multiples_repeat(tail, Lf, n - start):
             continue                                                      # (b)
         if abs(Lf - L) <= WHOLE:
@@ -227,14 +231,28 @@ def _off_grid_lines(y, N, m):
     if P < 2:
         return False
     lines, Y, var = _spectra(y[y.size - P * N:].reshape(P, N))
+    from .._dist import gamma_sf
+
     off = lines % m != 0
     p2 = np.abs(Y) ** 2
-    # each line against its own variance over the periods (|Y|^2 / (var / P) ~ F(2, 2 (P - 1))
-    # for noise): a coloured noise, the loop's response to a disturbance at a resonance, lies
-    # above a median pooled over neighbouring lines on the resonance's lines
+    noise, nu = _pooled(var, P)
+    # where the variances of a line and its neighbours (+-OWN_HALF_WINDOW) stand above the pooled
+    # median by more than sample variances' chance (OWN_LEVEL: noise that is not flat there, e.g.
+    # the loop's response to a disturbance at a resonance, or a low-pass disturbance), the line is
+    # judged against its own variance, |Y|^2 / (var / P) ~ F(2, 2 (P - 1)) for noise; the others
+    # against the median, as the line test
+    from scipy.ndimage import uniform_filter1d
+    w = min(2 * OWN_HALF_WINDOW + 1, var.size)
+    local = uniform_filter1d(var, size=w, mode="nearest")
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = np.where(p2 > 1e-20 * p2.max(), p2 / (var / P), 0.0)[off]
-    return bool(np.any(z > _threshold(int(off.sum()), P - 1)))
+        dof = w * (P - 1)
+        own = gamma_sf(np.where(noise > 0, local / noise, np.inf) * dof, dof) < OWN_LEVEL
+        live = p2 > 1e-20 * p2.max()
+        z_pool = np.where(live, p2 / (noise / P), 0.0)
+        z_own = np.where(live, p2 / (var / P), 0.0)
+    n = int(off.sum())
+    hit = np.where(own, z_own > _threshold(n, P - 1), z_pool > _threshold(n, nu))
+    return bool(np.any(hit[off]))
 
 
 # ------------------------------------------------------------------------------ the periods
