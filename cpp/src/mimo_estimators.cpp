@@ -105,12 +105,20 @@ struct Prep {
   int R() const { return static_cast<int>(d->rows.size()); }
 };
 
+// A row l <= K reads line 0 and the conjugates of lines 1..K-l: line i < 0 of a real signal's
+// spectrum is conj(line -i), with noise covariance conj(C_{-i}) (rows.hpp's Lines, one channel).
+cd signed_line(const MatrixXcd& X, int i, Eigen::Index col) { return i >= 0 ? X(i, col) : std::conj(X(-i, col)); }
+
+cd signed_cov(const MimoSpectra& d, int c, int i, int a, int b) {
+  return i >= 0 ? d.C(static_cast<Eigen::Index>(i) * c + a, b) : std::conj(d.C(static_cast<Eigen::Index>(-i) * c + a, b));
+}
+
 MatrixXcd regressors(const Params& p, const std::vector<int>& rows, const MatrixXcd& Y, const MatrixXcd& U) {
   MatrixXcd Phi(rows.size(), p.nphi);
   for (size_t r = 0; r < rows.size(); ++r)
     for (int j = 0; j < p.nphi; ++j) {
       const int i = rows[r] - p.k[j];
-      const cd x = p.is_a[j] ? Y(i, p.col[j]) : -U(i, p.col[j]);
+      const cd x = p.is_a[j] ? signed_line(Y, i, p.col[j]) : -signed_line(U, i, p.col[j]);
       Phi(r, j) = ipow(p.s(i), p.order[j]) * x;
     }
   return Phi;
@@ -129,9 +137,9 @@ void check(const std::vector<MimoSpectra>& data, const Params& p) {
       throw std::invalid_argument(where + ": the spectra or covariances contain NaN or inf");
     if (d.rows.empty()) throw std::invalid_argument(where + ".rows: no row");
     for (size_t r = 0; r < d.rows.size(); ++r) {
-      if (d.rows[r] - p.K < 1 || d.rows[r] + p.K > L1 - 1)
+      if (d.rows[r] < 1 || d.rows[r] + p.K > L1 - 1)
         throw std::invalid_argument(where + ".rows: line " + std::to_string(d.rows[r]) +
-                                    " reads lines outside 1..L (K = " + std::to_string(p.K) + ")");
+                                    " is not a row: rows are lines 1..L - K (K = " + std::to_string(p.K) + ")");
       if (r > 0 && d.rows[r] <= d.rows[r - 1]) throw std::invalid_argument(where + ".rows: must increase");
     }
   }
@@ -153,7 +161,7 @@ Prep prepare(const MimoSpectra& d, const Params& p) {
       for (int b = 0; b < p.nphi; ++b) {
         if (p.k[a] != p.k[b]) continue;
         const int i = d.rows[r] - p.k[a];
-        x.Cphi[r](a, b) = std::conj(f[a]) * f[b] * d.C(i * c + p.channel[b], p.channel[a]);
+        x.Cphi[r](a, b) = std::conj(f[a]) * f[b] * signed_cov(d, c, i, p.channel[b], p.channel[a]);
       }
     // T^H Cphi T through T's one or two nonzeros per column
     MatrixXcd& Cp = x.Cpsi[r];
@@ -427,7 +435,7 @@ HermitianBand row_covariance(const Prep& x, const Params& p, const BandBlocks& G
       for (int pp = 0; pp < ny; ++pp)
         for (int b = 0; b < c; ++b) {
           cd v(0.0, 0.0);
-          for (int a = 0; a < c; ++a) v += G.m(top + pp, a) * d.C(static_cast<Eigen::Index>(i) * c + a, b);
+          for (int a = 0; a < c; ++a) v += G.m(top + pp, a) * signed_cov(d, c, i, a, b);
           H(top + pp, b) = v;
         }
     }
@@ -473,18 +481,25 @@ MatrixXcd jacobian0(const Prep& x, const Params& p, const BandBlocks& G,
   const MimoSpectra& d = *x.d;
   const int R = x.R(), ny = p.ny, c = p.nc(), K = p.K;
   const Eigen::Index L1 = d.Y.rows();
-  MatrixXcd corr = MatrixXcd::Zero(L1, c);
+  MatrixXcd corr = MatrixXcd::Zero(L1 + K, c);  // signed lines -K..L at i + K
   for (int r = 0; r < R; ++r)
     for (int kk = 0; kk <= 2 * K; ++kk)
       for (int b = 0; b < c; ++b) {
         cd v(0.0, 0.0);
         const Eigen::Index top = (static_cast<Eigen::Index>(r) * (2 * K + 1) + kk) * ny;
         for (int pp = 0; pp < ny; ++pp) v += std::conj(G.m(top + pp, b)) * w(r * ny + pp);
-        corr(d.rows[r] - (kk - K), b) += v;
+        corr(d.rows[r] - (kk - K) + K, b) += v;
       }
+  // a row that reads conj(z_m) (line -m) moves z_m by C_m conj(its correction): the denoised
+  // spectrum stays that of a real signal (line 0, its own conjugate, takes 2 Re)
+  for (int m = K; m >= 0; --m) {
+    const Eigen::RowVectorXcd neg = corr.row(K - m).conjugate();
+    if (m > 0) corr.row(K - m).setZero();
+    corr.row(K + m) += neg;
+  }
   MatrixXcd Y0 = d.Y, U0 = d.U;
   for (Eigen::Index i = 0; i < L1; ++i) {
-    const VectorXcd dz = d.C.block(i * c, 0, c, c) * corr.row(i).transpose();
+    const VectorXcd dz = d.C.block(i * c, 0, c, c) * corr.row(i + K).transpose();
     Y0.row(i) -= dz.head(ny).transpose();
     U0.row(i) -= dz.tail(p.nu).transpose();
   }
@@ -654,6 +669,48 @@ MimoEstimate sml_impl(const std::vector<Prep>& preps, const Params& p, const Vec
   return out;
 }
 
+// Re(WJ^H P_E conj(WJ)) with P_E = E{e e^T}, the residues' pseudo-covariance: zero for
+// circular noise but between rows l, l' that read a line i and its conjugate -i (l + l' <= 2K),
+// where it is G_{l,i} C_i G_{l',-i}^T (E{z_i z_{-i}^T} = E{z_i z_i^H}); line 0 is its own conjugate.
+MatrixXd pseudo_term(const Prep& x, const Params& p, const BandBlocks& G, const MatrixXcd& WJ) {
+  const MimoSpectra& d = *x.d;
+  const int K = p.K, ny = p.ny, c = p.nc(), W = 2 * K + 1;
+  std::vector<int> low;
+  for (int r = 0; r < x.R(); ++r)
+    if (d.rows[r] <= 2 * K - 1) low.push_back(r);
+  if (low.empty()) return MatrixXd::Zero(WJ.cols(), WJ.cols());
+  const Eigen::Index n = static_cast<Eigen::Index>(low.size()) * ny;
+  MatrixXcd PE = MatrixXcd::Zero(n, n), Ci(c, c);
+  for (size_t a = 0; a < low.size(); ++a)
+    for (size_t b = 0; b < low.size(); ++b) {
+      const int r = low[a], r2 = low[b];
+      for (int kk = 0; kk < W; ++kk) {
+        const int i = d.rows[r] - (kk - K);
+        const int k2 = d.rows[r2] + i;  // row r2 reads line -i at harmonic k2
+        if (k2 < -K || k2 > K) continue;
+        for (int u = 0; u < c; ++u)
+          for (int v = 0; v < c; ++v) Ci(u, v) = signed_cov(d, c, i, u, v);
+        PE.block(static_cast<Eigen::Index>(a) * ny, static_cast<Eigen::Index>(b) * ny, ny, ny) +=
+            G(r, kk) * Ci * G(r2, k2 + K).transpose();
+      }
+    }
+  MatrixXcd sub(n, WJ.cols());
+  for (size_t a = 0; a < low.size(); ++a)
+    sub.middleRows(static_cast<Eigen::Index>(a) * ny, ny) = WJ.middleRows(static_cast<Eigen::Index>(low[a]) * ny, ny);
+  return (sub.adjoint() * PE * sub.conjugate()).real();
+}
+
+// Rows l <= K read line 0 and conjugate lines, whose noise is not circular: the circular complex
+// likelihood of SML and the Fisher information do not hold for them.
+void circular_rows(const std::vector<Prep>& preps, const Params& p, const std::string& what) {
+  for (size_t e = 0; e < preps.size(); ++e)
+    if (preps[e].R() > 0 && preps[e].d->rows[0] <= p.K)
+      throw std::invalid_argument("data[" + std::to_string(e) + "].rows: line " + std::to_string(preps[e].d->rows[0]) +
+                                  " reads line 0 and conjugate lines (K = " + std::to_string(p.K) +
+                                  "), whose noise is not circular: " + what +
+                                  " is the circular complex likelihood's; rows from K + 1");
+}
+
 MatrixXd sandwich_impl(const std::vector<Prep>& preps, const Params& p, const VectorXd& xi) {
   const std::vector<int> free = free_of(p);
   const MatrixXcd Th = theta_of(p, xi);
@@ -670,7 +727,7 @@ MatrixXd sandwich_impl(const std::vector<Prep>& preps, const Params& p, const Ve
     MatrixXcd WJ(J.rows(), nf);
     for (int r = 0; r < x.R(); ++r) WJ.middleRows(r * p.ny, p.ny) = W[r] * J.middleRows(r * p.ny, p.ny);
     H += (J.adjoint() * WJ).real();
-    Mt += 0.5 * (WJ.adjoint() * CE.multiply(WJ)).real();
+    Mt += 0.5 * (WJ.adjoint() * CE.multiply(WJ)).real() + 0.5 * pseudo_term(x, p, G, WJ);
   }
   const MatrixXd Hi = H.inverse();
   return Hi * Mt * Hi;
@@ -697,12 +754,16 @@ MimoEstimate mimo_wgtls(const std::vector<MimoSpectra>& data, const MimoStructur
 MimoEstimate mimo_sml(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi0, double tol,
                       int max_iter) {
   const Params p = checked_params(s, &xi0);
-  return sml_impl(prepare_all(data, p), p, xi0, tol, max_iter);
+  const std::vector<Prep> preps = prepare_all(data, p);
+  circular_rows(preps, p, "SML");
+  return sml_impl(preps, p, xi0, tol, max_iter);
 }
 
 MatrixXd mimo_fisher(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
   const Params p = checked_params(s, &xi);
-  return evaluate(prepare_all(data, p), p, xi, free_of(p), true).F;
+  const std::vector<Prep> preps = prepare_all(data, p);
+  circular_rows(preps, p, "the Fisher information");
+  return evaluate(preps, p, xi, free_of(p), true).F;
 }
 
 MatrixXd mimo_sandwich(const std::vector<MimoSpectra>& data, const MimoStructure& s, const VectorXd& xi) {
@@ -726,7 +787,10 @@ MimoFit mimo_fit(const std::vector<MimoSpectra>& data, const MimoStructure& s, c
   MimoFit out;
   out.estimate = wgtls_impl(preps, p, all_zero(data), tol, max_iter, method != "gtls");
   const bool noisy = !out.estimate.noise_free;
-  if (method == "sml" && noisy) out.estimate = sml_impl(preps, p, out.estimate.xi, tol, max_iter);
+  if (method == "sml" && noisy) {
+    circular_rows(preps, p, "SML");
+    out.estimate = sml_impl(preps, p, out.estimate.xi, tol, max_iter);
+  }
   if (covariance && noisy) {
     if (method == "sml") {
       Eigen::LLT<MatrixXd> llt(out.estimate.information);

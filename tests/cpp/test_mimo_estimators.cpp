@@ -151,8 +151,13 @@ TEST_CASE("MIMO estimators refuse bad input", "[mimo_estimators]") {
   auto data = experiments(m, 0.01, 4);
   lptv::MimoStructure s = structure();
   auto bad = data;
-  bad[0].rows = {1, 2, 3};  // row 1 reads line 0
+  bad[0].rows = {0, 1, 2};  // line 0 is not a row (rows are lines 1..L - K)
   REQUIRE_THROWS_AS(lptv::mimo_wgtls(bad, s, 1e-10, 10), std::invalid_argument);
+  bad[0].rows = {1, 2, 3};  // row 1 reads line 0: WGTLS takes it, the circular likelihood does not
+  const lptv::MimoEstimate low = lptv::mimo_wgtls(bad, s, 1e-10, 10);
+  REQUIRE(low.xi.allFinite());
+  REQUIRE_THROWS_AS(lptv::mimo_sml(bad, s, low.xi, 1e-10, 10), std::invalid_argument);
+  REQUIRE_THROWS_AS(lptv::mimo_fisher(bad, s, low.xi), std::invalid_argument);
   bad = data;
   bad[1].C.conservativeResize(bad[1].C.rows() - 1, Eigen::NoChange);
   REQUIRE_THROWS_AS(lptv::mimo_wgtls(bad, s, 1e-10, 10), std::invalid_argument);

@@ -1164,7 +1164,7 @@ def cli_cases():
     add("identify-outputs-missing", ok + ("--output", "y,force"), "--output")
     add("identify-outputs-empty-name", ok + ("--output", "y,"), "--output")
     add("identify-outputs-known", ok + ("--output", "y,w0", "--known", "a1=1"), "--known")
-    add("identify-outputs-scale", ok + ("--output", "y,w0", "--scale", "b0=1"), "--scale")
+    add("identify-outputs-scale", ok + ("--output", "y,w0", "--scale", "b0=0"), "--scale")
     add("identify-time-missing", ok + ("--time", "clock"), "--time")
     add("identify-resume-one-file", ok + ("--resume",), "--resume")
     add("identify-resume-nothing", ok + ("--workers", "1", "--out", "{dir}/batch", "--resume"), "--resume")

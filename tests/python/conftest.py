@@ -334,6 +334,39 @@ MIMO_FROZEN_POLES = 1e-12
 
 
 # ==================================================================================================
+# Several channels against one: tests/python/test_mimo_as_one_channel.py.
+# ==================================================================================================
+
+# A 1 x 1 fit by the route of several channels against the one-channel fit of the same arrays,
+# rows from line 1 (row 1 reads line 0 and line 2 at K = 1): the same WGTLS, each iterated to a
+# step of 1e-10 relative, so the estimates agree to well below that over their std (measured at
+# most 6e-12 std over 5 seeds, K = 1 and 2). The std: the one-channel sandwich adds a second-order
+# term (2e-6 .. 3e-5 of the std on these records), and on rows that read conjugate lines the
+# route of several channels denoises its Jacobian with the circular residue covariance where the
+# one channel's real likelihood has the exact one (against the one-channel first-order sandwich,
+# lik.sandwich_covariance: 1e-14 on rows from K + 1, 1e-10 on rows that read line 0 only, 1e-6 ..
+# 2.3e-5 on rows that read conjugate lines). Measured against the one-channel result: at most
+# 3.7e-5; 1e-4 leaves a factor 3, and a pseudo-covariance left out or a line read unconjugated
+# moves the std by far more (a row's variance, 1/24 of the information, is 4e-2).
+MIMO_1X1_ETA = 1e-8
+MIMO_1X1_STD = 1e-4
+
+# The decoupled 2 x 2 fit against the one-channel fits of the same two orthogonal experiments:
+# the 2 x 2 fit also estimates the couplings (true 0) from noisy regressors, so the two
+# estimators differ by noise. Over 20 seeds (10 free parameters each) the diagonal entries
+# differed by at most 1.49 one-channel std (rows from line 2) and 0.97 (rows from line 1), and
+# the std ratio lay in 0.90-1.08 (from line 2) and 0.93-1.20 (from line 1); 2.5 std and 0.8-1.25
+# hold the tests' seeds, and a wrong weighting or interval (a factor 2 in a variance: 0.71 or
+# 1.41) fails.
+MIMO_DECOUPLED_SIGMAS = 2.5
+MIMO_DECOUPLED_STD_RATIO = (0.8, 1.25)
+
+# The model scaled from the left (S A, S B) against the model itself: the same solution to the
+# rounding of one 2 x 2 product per coefficient and of two FDS solves of condition below 10.
+MIMO_SCALED_SAME_SYSTEM = 1e-10
+
+
+# ==================================================================================================
 # Batch runs and Monte Carlo studies: tests/python/test_batch.py and test_cli_batch.py.
 # ==================================================================================================
 

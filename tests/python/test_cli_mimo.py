@@ -116,7 +116,7 @@ def test_the_command_gives_the_python_api_model_and_accepts_the_right_structure(
     rc, out, err = identify_cli(capsys, *files, *FIT, "--method", method, "--out", tmp_path / "o")
     assert rc == 0, out + err
     assert "2 experiments, 2 inputs (F1 [N], f2 [N]), 2 outputs (x1 [m], x2 [m])" in out.splitlines()[0]
-    assert "verdict: consistent" in out
+    assert "verdict: the model is consistent with the noise" in out
     res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0, method=method)
     f = lptv.floquet(res.model)
     assert f"stability: stable: 4 Floquet multipliers, the largest of magnitude {f.spectral_radius:.6g}" in out
@@ -148,7 +148,7 @@ def test_a_missing_harmonic_is_a_model_error(files, tmp_path, capsys):
     fit = [x if x != "1,0,0" else "0" for x in FIT]           # --ka 0: K(t) taken as constant
     rc, out, err = identify_cli(capsys, *files, *fit, "--out", tmp_path / "o")
     assert rc == 3, out + err
-    assert "verdict: model error" in out
+    assert "verdict: MODEL ERRORS: the model is rejected" in out
 
 
 @needs_fit
@@ -175,8 +175,8 @@ def test_npz_periods_with_a_stored_fs_and_a_discrete_time_model(experiments, tmp
 
 @needs_fit
 def test_the_fit_s_refusals_name_the_options(files, tmp_path, capsys):
-    rc, out, err = identify_cli(capsys, *files, *FIT, "--lines", "1-20", "--out", tmp_path / "o")
-    assert rc == 2 and err.startswith("lptv identify: error: --lines: line 1 (") and "outside" in err
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--lines", "0-20", "--out", tmp_path / "o")
+    assert rc == 2 and err.startswith("lptv identify: error: --lines: line 0 (") and "outside" in err
     rc, out, err = identify_cli(capsys, *files, *FIT, "--method", "ls", "--out", tmp_path / "o")
     assert rc == 2 and "--method" in err and len(err.strip().splitlines()) == 1
 
@@ -192,7 +192,7 @@ def test_noise_free_records_give_the_system_and_no_verdict(tmp_path, capsys):
         files.append(write_csv(tmp_path / f"e{e}.csv", np.tile(u1, (P, 1, 1)), np.tile(y1, (P, 1, 1))))
     rc, out, err = identify_cli(capsys, *files, *FIT, "--out", tmp_path / "o")
     assert rc == 4, out + err
-    assert "verdict: no verdict" in out
+    assert "verdict: NOT DETERMINED" in out
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["model_ok"] is None and all(p["std"] is None for p in summary["parameters"])
     values = np.array([p["value"] for p in summary["parameters"]])
@@ -240,7 +240,7 @@ def test_the_report_shows_the_verdict_the_parameters_and_each_output_s_residue(e
     assert rc == 0, out + err
     page = (tmp_path / "o" / "report.html").read_text()
     res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0)
-    assert "Verdict:</b> consistent" in page
+    assert "Verdict:</b> the model is consistent with the noise" in page
     assert all(n in page for n in res.parameter_names)
     assert (tmp_path / "o" / "residues.png").exists() and (tmp_path / "o" / "stability.png").exists()
     captured = {}
@@ -309,7 +309,7 @@ def test_inspect_several_channels_suggests_the_command_that_fits_them(files, tmp
     argv = [argv[2], str(files[1])] + [fill.get(a, a) for a in argv[3:]] + ["--out", str(tmp_path / "o")]
     rc, out, err = identify_cli(capsys, *argv)
     assert rc == 0, out + err
-    assert "verdict: consistent" in out
+    assert "verdict: the model is consistent with the noise" in out
     period = float(argv[argv.index("--period") + 1])
     assert period == pytest.approx(T0, rel=1e-9)
 

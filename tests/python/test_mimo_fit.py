@@ -199,7 +199,7 @@ def test_result_interface():
     assert np.allclose(res.eta[fixed], [1, 0, 0, 1]) and np.all(res.parameter_std[fixed] == 0)
     # one experiment of a (P, N, nu) pair, the wrong structure (no time variation) is rejected
     bad = lptv.identify(pairs, w0=mx.W0, method="wgtls", na=2, nb=0, ka=0, kb=0)
-    assert bad.model_ok is False and bad.model_errors and bad.verdict.startswith("model error")
+    assert bad.model_ok is False and bad.model_errors and bad.verdict.startswith("MODEL ERRORS: the model is rejected: ")
 
 
 def _pairs():

@@ -15,7 +15,9 @@ struct MimoSpectra {
   Eigen::MatrixXcd U;  // (L+1) x nu
   // (L+1) (ny+nu) x (ny+nu): rows l (ny+nu) .. the covariance E{dz dz^H} of z_l = [Y_l; U_l]
   Eigen::MatrixXcd C;
-  std::vector<int> rows;  // sorted lines, every line a row reads (l-K..l+K) in 1..L
+  // sorted lines 1..L-K; a row l <= K reads line 0 and conjugate lines (WGTLS, GTLS, the
+  // sandwich and the residues take them; SML and the Fisher information refuse them)
+  std::vector<int> rows;
 };
 
 // Row-uniform structure: harmonic count per order and column, ka (na+1) x ny, kb (nb+1) x nu.

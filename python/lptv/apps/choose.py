@@ -87,6 +87,13 @@ def _error(problem) -> int:
 
 def run(args) -> int:
     src = args.file
+    several = [f"{opt} {v}" for opt, v in (("--input", getattr(args, "input", None)),
+                                          ("--output", getattr(args, "output", None))) if v and "," in v]
+    if several:
+        return _error(f"{several[0]}: several channels: lptv select ranks structures of one input and one output (its "
+                      "guide, the nonparametric HTF, and its grid of orders and one harmonic count are the "
+                      "one-channel model's; a matrix model has a count per entry); fit each candidate structure with "
+                      "lptv identify FILES --input ... --output ... and compare their verdicts")
     try:
         na, nb = parse_grid(args.na, "--na"), parse_grid(args.nb, "--nb")
         k = parse_grid(args.k, "--k") if args.k is not None else None

@@ -9,8 +9,13 @@ the same and may be given. A single file is one experiment (enough for one input
 inputs excite different lines). Writes ``model.json`` (:meth:`lptv.MimoModel.load`) and
 ``summary.json`` and ``report.html`` (the verdict, the parameters, each output's normalised
 residue, the Floquet multipliers and frozen poles; not with ``--no-report``), prints the
-parameters with their standard deviations, the verdict and the estimate's stability. Exit status as for one channel: 0 consistent, 3 MODEL ERRORS, 4 no verdict,
-2 a file or option that cannot be used (a one-line error), 1 a computation that failed.
+parameters with their standard deviations and 95 % intervals (each entry's unit where the
+channels' names state theirs, ``force [N]``), the verdict and the estimate's stability;
+``--scale b0=1`` adds them in physical form (the equation multiplied from the left so that the
+mean of B_0 is the identity: M, C, K of M y'' + C y' + K(t) y = F). Exit status as for one
+channel: 0 consistent, 3 MODEL ERRORS, 4 NOT DETERMINED (no noise statistics, or the data do
+not determine the model), 2 a file or option that cannot be used (a one-line error), 1 a
+computation that failed.
 
 Example::
 
@@ -31,7 +36,7 @@ import lptv
 from lptv import NumericalError
 from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fundamental, in_option_terms, integer,
                                output_folder, parse_counts, parse_lines, positive, read_options)
-from lptv.apps import inspectrec
+from lptv.apps import inspectrec, units
 from lptv.apps.report import write_fit
 from lptv.apps.stability import stability_summary, stability_text
 from lptv.records.measurements import FileError, read_measurements
@@ -43,7 +48,7 @@ NEEDS_FIT = ("several inputs or outputs need the MIMO fit (lptv.identify on arra
 # Options of the one-channel fit that the fit of several channels does not take (and their
 # value when not given).
 _NOT_FOR_MIMO = {"one_record": False, "input_noise": None, "remove_disturbances": False, "known": None,
-                 "scale": None, "workers": None, "scheduler": None, "resume": False}
+                 "workers": None, "scheduler": None, "resume": False}
 
 
 def several_channels(args) -> bool:
@@ -75,8 +80,13 @@ def _check_options(args):
     for key, default in _NOT_FOR_MIMO.items():
         if getattr(args, key, default) != default:
             opt = "--" + key.replace("_", "-")
+            if key in ("workers", "scheduler", "resume"):
+                raise FileError(f"{opt} runs a batch, one fit per file; with several channels the files are the "
+                                "experiments of one system fitted together into one model (a batch of fits of "
+                                "several channels each is not built): give the files without it")
             raise FileError(f"{opt} is for one input and one output; several channels take the files, "
-                            "--input, --output, the structure, --lines, --method, --noise, --max-iter, --tol and --out")
+                            "--input, --output, the structure, --lines, --method, --noise, --scale, --max-iter, --tol "
+                            "and --out")
     if getattr(args, "referred", "auto") not in ("auto",):
         raise FileError("--referred is for records of realisations of one input and one output")
     if args.covariance != "analytic":
@@ -149,6 +159,7 @@ def run(args) -> int:
         _check_options(args)
         lines = parse_lines(args.lines) if args.lines is not None else None
         ka, kb = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb")
+        scale = units.parse_scale(getattr(args, "scale", None))
         records, w0, ts = read_experiments(args)
         if not mimo_fit_available():
             raise FileError(NEEDS_FIT)
@@ -167,16 +178,24 @@ def run(args) -> int:
     except ValueError as e:
         return _fail(in_option_terms(_named(e, files), OPTION_NAMES))
     notes = [str(w.message) for w in caught if str(w.message) not in getattr(res, "warnings", ())]
+    first = records[0][1]
+    u_units = [units.channel_unit(n) for n in first.input]
+    y_units = [units.channel_unit(n) for n in first.output]
+    try:
+        physical = units.scaled_mimo(res, *scale) if scale else None
+    except FileError as e:
+        return _fail(e)
 
     out = Path(args.out) if args.out else Path(Path(files[0]).stem + "-lptv")
-    first = records[0][1]
     print(f"lptv identify: {len(files)} experiment{'s' if len(files) > 1 else ''}, "
           f"{res.model.n_inputs} inputs ({', '.join(first.input)}), {res.model.n_outputs} outputs "
           f"({', '.join(first.output)}), w0 = {w0:.6g} rad/s"
           + (f", discrete-time model with ts = {ts:g} s" if ts else ", continuous-time model") + f" -> {out}/")
     for e, (src, meas) in enumerate(records):
         print(f"  #{e} {src} ({meas.format}): {meas.u.shape[0]} periods of {meas.u.shape[1]} samples")
-    print(text_summary(res))
+    print(text_summary(res, u_units, y_units))
+    if physical is not None:
+        print(physical_text(physical, u_units, y_units))
     stability = stability_of(res.model)
     print(f"stability: {stability['text']}")
     stab = stability_summary(res)
@@ -185,6 +204,8 @@ def run(args) -> int:
     for msg in list(getattr(res, "warnings", ())) + notes:
         print(f"warning: {msg}")
     summary = json_summary(args, records, w0, ts, ka, kb, res, notes)
+    summary["scale"] = None if scale is None else {"coefficient": scale[0], "value": scale[1]}
+    summary["parameters_scaled"] = None if physical is None else physical_rows(physical, u_units, y_units)
     summary["stability"] = {k: v for k, v in stability.items() if k != "text"}
     summary["stability_uncertainty"] = stab
     if getattr(args, "no_report", False):
@@ -193,7 +214,7 @@ def run(args) -> int:
         def report():
             from lptv.apps.mimoreport import build
             return build(res, files=files, inputs=list(first.input), outputs=list(first.output), w0=w0,
-                         stability=stability)
+                         stability=stability, physical=physical, experiments=experiments)
     failed = write_fit(out, res.model, summary, report)
     if failed:
         return _fail(failed[1] if failed[0] is None else f"{failed[0]}: {failed[1]}")
@@ -216,10 +237,12 @@ def stability_of(model) -> dict:
 
 
 def status_of(res) -> int:
-    """0 consistent, MODEL_REJECTED (3) for model errors, NOT_DETERMINED (4) without a verdict."""
-    if res.model_ok is None:
-        return NOT_DETERMINED
-    return 0 if res.model_ok else MODEL_REJECTED
+    """As for one channel (:func:`lptv.apps.options.verdict_status`): MODEL_REJECTED (3) for model
+    errors, NOT_DETERMINED (4) when the data give no verdict or do not determine the model, 0
+    when the verdict calls the model consistent."""
+    if res.model_ok is False:
+        return MODEL_REJECTED
+    return 0 if res.model_ok and getattr(res, "undetermined", None) is None else NOT_DETERMINED
 
 
 def _named(e, files) -> str:
@@ -229,38 +252,48 @@ def _named(e, files) -> str:
                   else m.group(0), str(e))
 
 
-def _std(res):
-    try:
-        return res.parameter_std
-    except (ValueError, AttributeError):
-        return None
+def text_summary(res, u_units=(), y_units=()) -> str:
+    """:meth:`lptv.MimoIdentificationResult.summary`: the method, convergence, the noise route, the
+    parameters with their std and 95 % intervals (each entry's unit where the channels state
+    theirs) and the verdict."""
+    return res.summary(units=units.mimo_coefficient_units(res.model, u_units, y_units))
 
 
-def text_summary(res) -> str:
-    """The method, convergence, the parameters with their standard deviations, the verdict."""
-    std = _std(res)
-    lines = [f"method {res.method.upper()}, converged {res.converged}, cost {res.cost:.4g}, "
-             f"{res.lines.size} rows, {getattr(res, 'n_free_parameters', res.eta.size)} free parameters"]
-    if getattr(res, "noise", None):
-        choice = res.noise_choice
-        if choice in ("", "asked for"):
-            lines.append(f"noise (co)variances: {res.noise} (asked for)")
-        else:     # noise='auto': the route and why, e.g. 'moderated: the noise spectrum is smooth ...'
-            lines.append(f"noise (co)variances (noise='auto'): {choice}")
-    width = max((len(n) for n in res.parameter_names), default=9)
-    lines.append(f"{'parameter':<{width}}  {'estimate':>14}  {'std':>11}")
-    for i, name in enumerate(res.parameter_names):
-        s = "-" if std is None or not np.isfinite(std[i]) else f"{std[i]:11.4g}"
-        if std is not None and std[i] == 0:
-            s = "(normalised)"
-        lines.append(f"{name:<{width}}  {res.eta[i]:14.7g}  {s:>11}")
-    lines.append(f"verdict: {res.verdict}")
-    return "\n".join(lines)
+def _physical_table(physical, u_units, y_units):
+    """The rows of :meth:`lptv.MimoIdentificationResult.parameters` of the scaled parameters."""
+    from lptv.judgement.mimo_result import parameter_rows
+
+    name = physical.scale[0]
+    fixed = frozenset(n for n in physical.eta_names if n.startswith(f"{name}[") and n.endswith(".re0"))
+    return parameter_rows(physical.eta_names, physical.eta, physical.covariance, 0.95, fixed)
+
+
+def physical_rows(physical, u_units, y_units) -> list:
+    """summary.json's ``parameters_scaled``: the rows of the scaled parameters with their unit."""
+    unit_of = units.mimo_coefficient_units(physical.model, u_units, y_units, physical.scale)
+    rows = _physical_table(physical, u_units, y_units)
+    for r in rows:
+        r["unit"] = unit_of.get(r["name"].split(".")[0], "")
+        if r["kind"] == "normalised":
+            r["kind"] = "scaled"
+    return rows
+
+
+def physical_text(physical, u_units, y_units) -> str:
+    """What ``--scale`` prints: the scaled parameters with their std, 95 % intervals and units."""
+    from lptv.judgement.mimo_result import format_table
+
+    name, value = physical.scale
+    unit_of = units.mimo_coefficient_units(physical.model, u_units, y_units, physical.scale)
+    return (f"parameters in physical form (--scale {name}={value:g}: the mean of {name} is {value:g} times the "
+            "identity):\n" + format_table(_physical_table(physical, u_units, y_units), 0.95, unit_of)
+            .replace("(normalised)", "(by --scale)"))
 
 
 def json_summary(args, records, w0, ts, ka, kb, res, notes) -> dict:
-    std = _std(res)
     first = records[0][1]
+    unit_of = units.mimo_coefficient_units(res.model, [units.channel_unit(n) for n in first.input],
+                                           [units.channel_unit(n) for n in first.output])
     return {
         "files": [str(src) for src, _ in records], "n_experiments": len(records),
         "experiments": [{"file": str(src), "format": m.format, "periods": int(m.u.shape[0]),
@@ -272,9 +305,8 @@ def json_summary(args, records, w0, ts, ka, kb, res, notes) -> dict:
         "method": res.method, "noise": getattr(res, "noise", "sample"), "noise_choice": getattr(res, "noise_choice", ""),
         "n_rows": int(res.lines.size), "converged": bool(res.converged),
         "cost": float(res.cost),
-        "parameters": [{"name": n, "value": float(res.eta[i]),
-                        "std": None if std is None else float(std[i])}
-                       for i, n in enumerate(res.parameter_names)],
+        "parameters": [dict(r, unit=unit_of.get(r["name"].split(".")[0], "")) for r in res.parameters(0.95)],
         "verdict": res.verdict, "model_ok": res.model_ok, "model_errors": list(res.model_errors),
+        "undetermined": res.undetermined,
         "warnings": list(getattr(res, "warnings", ())) + notes,
     }

@@ -21,13 +21,34 @@ def normalised_residues(res) -> np.ndarray:
         return np.abs(e) ** 2 / var
 
 
-def build(res, *, files, inputs, outputs, w0, stability) -> Report:
-    """The report of a fit of several channels (``stability``: mimoid.stability_of's dict)."""
+def predicted_outputs(model, u, y):
+    """One period of each output: the mean of the periods of ``y`` (P, N, ny) and the model's
+    steady-state output simulated from the mean of ``u`` (P, N, nu) (:func:`lptv.simulate`), both
+    (N, ny), and each output's fit in percent, 100 (1 - ||y - yhat|| / ||y - mean y||)."""
+    import lptv
+
+    u_mean, y_mean = np.mean(u, axis=0), np.mean(y, axis=0)
+    n = u_mean.shape[0]
+    U = np.fft.rfft(u_mean, axis=0) / n
+    Y = np.asarray(lptv.simulate(model, U, lines_out=U.shape[0] - 1, warn_unstable=False)).reshape(U.shape[0], -1)
+    y_hat = np.fft.irfft(n * Y, n, axis=0)
+    err = np.linalg.norm(y_mean - y_hat, axis=0)
+    spread = np.linalg.norm(y_mean - y_mean.mean(axis=0), axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fit = 100.0 * (1.0 - err / spread)
+    return y_mean, y_hat, fit
+
+
+def build(res, *, files, inputs, outputs, w0, stability, physical=None, experiments=None) -> Report:
+    """The report of a fit of several channels (``stability``: mimoid.stability_of's dict;
+    ``physical``: the parameters of ``--scale``, :func:`lptv.apps.units.scaled_mimo`;
+    ``experiments``: the (u, y) periods of each file, for the measured and predicted outputs)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     import lptv
+    from lptv.apps import units
 
     model = res.model
     rep = Report("lptv identify: a model of several inputs and outputs")
@@ -42,13 +63,22 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
     choice = getattr(res, "noise_choice", "")
     rep.paragraph(f"Noise (co)variances: {route} (asked for)." if choice in ("", "asked for") else
                   f"Noise (co)variances (noise='auto'): {choice}.")
-    std = res.parameter_std
-    rows = []
-    for i, name in enumerate(res.parameter_names):
-        s = "-" if std is None else ("(normalised)" if std[i] == 0 else f"{std[i]:.4g}")
-        rows.append([name, f"{res.eta[i]:.7g}", s])
+    u_units = [units.channel_unit(n) for n in inputs]
+    y_units = [units.channel_unit(n) for n in outputs]
     rep.heading("Parameters")
-    rep.table(["parameter", "estimate", "std"], rows)
+    rep.table(["parameter", "estimate", "std", "95 % interval", "unit"],
+              _parameter_rows(res.parameters(0.95), units.mimo_coefficient_units(model, u_units, y_units)))
+    if physical is not None:
+        from lptv.apps.mimoid import _physical_table
+
+        name, value = physical.scale
+        rep.paragraph(f"In physical form (--scale {name}={value:g}): the equation multiplied from the left so that "
+                      f"the mean of {name} is {value:g} times the identity (the same system; the covariance carried "
+                      "by the exact Jacobian of that map).")
+        rep.table(["parameter", "value", "std", "95 % interval", "unit"],
+                  _parameter_rows(_physical_table(physical, u_units, y_units),
+                                  units.mimo_coefficient_units(physical.model, u_units, y_units, physical.scale),
+                                  fixed="(by --scale)"))
 
     # each output's normalised residue over the rows, against its single-row 99 % point
     z = normalised_residues(res)
@@ -66,16 +96,23 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
         if P >= 2:
             from scipy.special import fdtri
             ax.axhline(10 * np.log10(fdtri(2, 2 * (P - 1), 0.99)), color="C3", lw=0.8, ls="--")
-        ax.set_ylabel(f"{outputs[p]} (dB)")
+        ax.set_ylabel(residue_label(outputs[p]))
     axes[-1, 0].set_xlabel("frequency of the row (rad/s)")
     fig.tight_layout()
     rep.heading("Residues")
+    worth = ", what the moderated noise is worth" if route in ("moderated", "full-moderated") else ""
     rep.figure(fig, "residues.png",
                "Each output's normalised residue |e_p|^2 / C_e[p, p] on the rows of the fit (all experiments), "
-               "in dB: about 0 dB (its mean) where the model is right; the dashed line is the 99 % point of "
-               f"F(2, 2(P-1)) for one row (P = {P}{', what the moderated noise is worth' if route in ('moderated', 'full-moderated') else ''}); the verdict judges every row of every output and all "
-               "outputs jointly with Holm's correction, not by this line.")
+               "in dB relative to its own noise (the residue e_p is in the unit of output p's equation, C_e[p, p] in "
+               "its square: the ratio has no unit): about 0 dB (its mean) where the model is right; the dashed "
+               "line is the 99 % point of "
+               f"F(2, 2(P-1)) for one row (P = {P}{worth}); the verdict judges every row above line K (rows l <= K "
+               "read line 0 and conjugate lines) of every output and all outputs jointly with Holm's correction, "
+               "not by this line.")
     plt.close(fig)
+
+    if experiments:
+        _outputs_section(rep, res, files, outputs, w0, experiments, plt)
 
     rep.heading("Stability")
     rep.paragraph("The estimate is " + stability["text"] + ".")
@@ -114,4 +151,62 @@ def build(res, *, files, inputs, outputs, w0, stability) -> Report:
                + ") at 60 instants of the period; they show how the system varies and say nothing about "
                "the stability of the time-varying system.")
     plt.close(fig)
+    rep.heading("The fit")
+    rep.preformatted(res.summary(units=units.mimo_coefficient_units(model, u_units, y_units)))
     return rep
+
+
+def _outputs_section(rep, res, files, outputs, w0, experiments, plt):
+    """The measured and predicted outputs of each experiment over one period, each output in its
+    own unit (its name's)."""
+    from lptv import NumericalError
+
+    ny = res.model.n_outputs
+    E = len(experiments)
+    fig, axes = plt.subplots(ny, E, figsize=(4.2 * E + 1.5, 1.9 * ny + 0.8), squeeze=False, sharex=True)
+    fits = []
+    try:
+        for e, (u, y) in enumerate(experiments):
+            y_mean, y_hat, fit = predicted_outputs(res.model, u, y)
+            fits.append(fit)
+            t = np.arange(y_mean.shape[0]) * (2 * np.pi / w0) / y_mean.shape[0]
+            for p in range(ny):
+                ax = axes[p, e]
+                ax.plot(t, y_mean[:, p], color="C0", lw=1.0, label="measured (mean of the periods)")
+                ax.plot(t, y_hat[:, p], color="C3", lw=0.9, ls="--", label="model, from the measured input")
+                ax.set_title(f"{files[e]}: fit {fit[p]:.1f} %", fontsize=8)
+                if e == 0:
+                    ax.set_ylabel(outputs[p])
+            axes[-1, e].set_xlabel("time over one period (s)")
+        axes[0, 0].legend(fontsize=7, loc="best")
+        fig.tight_layout()
+    except (ValueError, NumericalError, np.linalg.LinAlgError):
+        plt.close(fig)
+        return
+    rep.heading("The model against the data")
+    rep.figure(fig, "outputs.png",
+               "Each output (rows, in its own unit) of each experiment (columns) over one period: the mean of the "
+               "measured periods and the model's steady-state output simulated from the measured input "
+               "(lptv.simulate); fit = 100 (1 - ||y - yhat|| / ||y - mean y||) per output: "
+               + "; ".join(f"{files[e]}: " + ", ".join(f"{outputs[p]} {f[p]:.1f} %" for p in range(ny))
+                           for e, f in enumerate(fits)) + ".")
+    plt.close(fig)
+
+
+def residue_label(output: str) -> str:
+    """The residue axis of one output: its name (with the unit it states, 'x1 [mm]') and that the
+    quantity is in dB relative to its noise (a ratio without unit)."""
+    return f"{output}: |e|^2 / C_e (dB)"
+
+
+def _parameter_rows(rows, unit_of, fixed="(normalised)"):
+    out = []
+    for r in rows:
+        unit = unit_of.get(r["name"].split(".")[0], "")
+        if r["kind"] == "normalised":
+            out.append([r["name"], f"{r['value']:.7g}", fixed, "", unit])
+        elif r["std"] is None:
+            out.append([r["name"], f"{r['value']:.7g}", "-", "-", unit])
+        else:
+            out.append([r["name"], f"{r['value']:.7g}", f"{r['std']:.4g}", f"[{r['low']:.6g}, {r['high']:.6g}]", unit])
+    return out

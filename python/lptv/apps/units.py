@@ -196,3 +196,110 @@ def physical_form(physical, meas) -> Tuple[str, list]:
     text = (f"parameters in physical form (--scale {name}={value:g}):\n"
             + format_parameter_table(physical, units=unit_of).replace("(normalised)", "(by --scale)"))
     return text, table_with_units(physical, u_unit, y_unit, physical.scale)
+
+
+# ------------------------------------------------------------------ several inputs and outputs
+
+_ENTRY = re.compile(r"([ab])(\d+)$")
+
+
+def _unit_text(e: dict) -> str:
+    num = [_tok(k, v) for k, v in e.items() if v > 0]
+    den = [_tok(k, -v) for k, v in e.items() if v < 0]
+    text = " ".join(num) or ("1" if den else "")
+    if den:
+        text += "/" + (den[0] if len(den) == 1 else "(" + " ".join(den) + ")")
+    return text
+
+
+def mimo_coefficient_units(model, u_units, y_units, scale: Optional[Tuple[str, float]] = None) -> dict:
+    """{'a0[0,1]': 'N/m', ...}: the unit of every entry of every A_n and B_m when every channel
+    states its unit ({} otherwise). Row p of the equation, sum_n A_n(t) d^n y = sum_m B_m(t) d^m u,
+    has one unit E_p: A_n[p, q] is E_p s^n / [y_q], B_m[p, r] is E_p s^m / [u_r] (no s in discrete
+    time); the matrix set to a number times the identity (``scale``, else A_na) has pure numbers on
+    its diagonal, which fixes E_p = [y_p] s^-na (or [u_p] s^-m for B_m, [y_p] s^-n for A_n)."""
+    u_units, y_units = list(u_units or ()), list(y_units or ())
+    if not u_units or not y_units or not all(u_units) or not all(y_units):
+        return {}
+    ny, nu = model.n_outputs, model.n_inputs
+    if len(y_units) != ny or len(u_units) != nu:
+        return {}
+    ct = not model.discrete
+    ref = scale[0] if scale else f"a{model.na}"
+    side, n0 = ref[0], int(ref[1:])
+    if side == "b" and nu != ny:
+        return {}
+    out = {}
+    for p in range(ny):
+        base = {(y_units if side == "a" else u_units)[p]: 1}
+        for c, count, chans in (("a", model.na, y_units), ("b", model.nb, u_units)):
+            for n in range(count + 1):
+                for q, chan in enumerate(chans):
+                    e = dict(base)
+                    e[chan] = e.get(chan, 0) - 1
+                    e["s"] = e.get("s", 0) + ((n - n0) if ct else 0)
+                    out[f"{c}{n}[{p},{q}]"] = _unit_text(e)
+    return out
+
+
+def scaled_mimo(res, name: str, value: float) -> SimpleNamespace:
+    """The parameters of a fit of several channels (``res``: model, parameter_names, eta,
+    covariance) with the equation multiplied from the left by S = value M^-1, M the mean matrix
+    of coefficient ``name``, so that that mean becomes ``value`` times the identity (the same
+    system; for M y'' + C y' + K(t) y = F, ``b0=1`` gives the matrices M, C, K). The covariance
+    follows by the exact Jacobian of that map. An object with ``model``, ``eta_names``, ``eta``,
+    ``covariance`` and ``scale = (name, value)``."""
+    from lptv import MimoModel
+
+    m = res.model
+    ny, nu = m.n_outputs, m.n_inputs
+    side, order = name[0], int(name[1:])
+    if order > (m.na if side == "a" else m.nb):
+        have = [f"a{i}" for i in range(m.na + 1)] + [f"b{i}" for i in range(m.nb + 1)]
+        raise FileError(f"--scale: {name} is not a coefficient of the model ({', '.join(have)})")
+    if side == "b" and nu != ny:
+        raise FileError(f"--scale: {name} is a {ny} x {nu} matrix ({ny} outputs, {nu} input{'s' if nu > 1 else ''}); "
+                        "several channels are scaled by setting the mean of one square matrix to a number times the "
+                        f"identity, which a {ny} x {nu} matrix cannot be: name an a_n ({ny} x {ny}), or a b_m with as "
+                        "many inputs as outputs")
+    names = list(res.parameter_names)
+    eta = np.asarray(res.eta, float)
+    n_row = eta.size // ny
+    idx = np.array([[names.index(f"{name}[{p},{q}].re0") for q in range(ny)] for p in range(ny)])
+    M = eta[idx]
+    cond = np.linalg.cond(M)
+    if not np.isfinite(cond) or cond > 1e8:
+        raise FileError(f"--scale: the mean of {name} is estimated as a singular matrix (condition number "
+                        f"{cond:.3g}); scale by another coefficient")
+    cov = res.covariance
+    if cov is not None:
+        # an entry of M within two standard deviations of 0 on the diagonal: the data do not fix the scale
+        d = np.diag(M)
+        sd = np.sqrt(np.maximum(np.diag(cov)[np.diag(idx)], 0.0))
+        weak = np.flatnonzero((sd > 0) & (np.abs(d) < 2 * sd))
+        if weak.size:
+            p = int(weak[0])
+            raise FileError(f"--scale: the mean of {name}[{p},{p}] ({d[p]:.3g}) is within two standard deviations "
+                            "of 0; scale by a coefficient the data determine")
+    Mi = np.linalg.inv(M)
+    S = value * Mi
+    Xi = eta.reshape(ny, n_row)                      # row p of the equation: Xi[p]
+    out_eta = (S @ Xi).ravel()
+    out_cov = None
+    if cov is not None:
+        # d(S Xi) = S dXi + dS Xi with dS = -S dM M^-1, dM the unit step of one entry of M
+        J = np.kron(S, np.eye(n_row))
+        for p in range(ny):
+            for q in range(ny):
+                E = np.zeros((ny, ny))
+                E[p, q] = 1.0
+                J[:, idx[p, q]] += (-S @ E @ Mi @ Xi).ravel()
+        out_cov = J @ cov @ J.T
+        fixed = idx.ravel()
+        out_cov[fixed, :] = 0.0
+        out_cov[:, fixed] = 0.0                       # the scaling matrix is fixed: exactly value * I
+    out_eta[idx.ravel()] = (value * np.eye(ny)).ravel()
+    a = np.einsum("pj,njqk->npqk", S, m.a)
+    b = np.einsum("pj,njrk->nprk", S, m.b)
+    return SimpleNamespace(model=MimoModel(a, b, w0=m.w0, ts=m.ts), eta_names=tuple(names),
+                           parameter_names=tuple(names), eta=out_eta, covariance=out_cov, scale=(name, value))

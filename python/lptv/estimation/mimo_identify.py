@@ -76,6 +76,11 @@ def _moderation_route(datas, noise):
     return "moderated", "moderated: " + "; ".join(why), mos
 
 
+def noise_route_noisy(datas) -> bool:
+    """Whether any experiment carries noise (co)variances."""
+    return any(np.max(np.abs(d.C)) > 0 for d in datas)
+
+
 def is_mimo(u, y) -> bool:
     """Whether identify's arguments are of several channels: 3-D arrays, MimoFrequencyData, or a
     list of experiments whose first is one of those."""
@@ -138,6 +143,9 @@ def _need_w0(w0):
 
 
 def _rows_of(d: MimoFrequencyData, lines, K: int, e: int):
+    """The rows of experiment ``e``: by default and for 'excited' the lines K+1 .. Lmax-K (rows
+    that read positive lines only), as for one channel; given lines from 1 up to Lmax-K, a row
+    l <= K reading line 0 and the conjugates of lines 1..K-l (a real signal's spectrum)."""
     lo, hi = K + 1, d.max_line - K
     if lines is None:
         rows = np.arange(lo, hi + 1)
@@ -151,10 +159,10 @@ def _rows_of(d: MimoFrequencyData, lines, K: int, e: int):
         rows = rows[(rows >= lo) & (rows <= hi)]
     else:
         rows = np.unique(np.asarray(as_lines(lines, "lines"), dtype=int))
-        bad = rows[(rows < lo) | (rows > hi)]
+        bad = rows[(rows < 1) | (rows > hi)]
         if bad.size:
-            raise ValueError(f"lines: line {int(bad[0])} (experiment {e}) is outside {lo}..{hi}: every line a row "
-                             f"reads (l - K .. l + K, K = {K}) must be a measured line >= 1 up to N/2")
+            raise ValueError(f"lines: line {int(bad[0])} (experiment {e}) is outside 1..{hi}: rows are lines >= 1 "
+                             f"and every line a row reads (l - K .. l + K, K = {K}) must be measured, up to N/2")
     if rows.size == 0:
         raise ValueError(f"lines: experiment {e} has no row: it needs lines {lo}..{hi} (K = {K})")
     return rows
@@ -211,11 +219,17 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     else:
         per = [lines] * len(datas)
     rows_list = [_rows_of(d, v, st.K, e) for e, (d, v) in enumerate(zip(datas, per))]
+    low = [int(r[r <= st.K][0]) for r in rows_list if np.any(r <= st.K)]
+    if low and method == "sml" and noise_route_noisy(datas):
+        raise ValueError(f"lines: line {low[0]} is a row l <= K = {st.K}, which reads line 0 and the conjugates of "
+                         "lines 1..K-l, whose noise is not circular; method='sml' for several channels weighs the rows "
+                         "by the circular complex likelihood, which such rows do not have: give rows from "
+                         f"{st.K + 1}, or use method='wgtls' (its residue covariance and sandwich take them)")
     n_eq = sum(2 * r.size * ny for r in rows_list)
     if n_eq < st.free.size:
         raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters")
     P = np.array([d.periods for d in datas])
-    noisy = any(np.max(np.abs(d.C)) > 0 for d in datas)
+    noisy = noise_route_noisy(datas)
     # the periods the (co)variances are worth: P, or 1 + dof / 2 of the moderated ones (the
     # median over the inner lines for the covariance's factor, each row's own for its tests)
     Pcov = P if mos is None else np.array([max(int(d.periods), int(round(1.0 + float(np.median(m.dof[1:-1])) / 2.0)))
@@ -280,7 +294,13 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         _, Cv = residues(core_data([m.unbiased_data() for m in mos], rows_list), cst, xi_fit)
         if lead is not None:
             Cv = np.einsum("pi,rij,qj->rpq", lead, Cv, lead)
-    tests = () if noise_free else residue_tests(res, Cv, row_P)
+    # rows l <= K read line 0 or a conjugate line: residues that are not circular, which the F
+    # tests assume; they are fitted but not judged (as for one channel)
+    row_lines = np.concatenate(rows_list)
+    judged = np.flatnonzero(row_lines > st.K)
+    tests = () if noise_free else tuple((int(judged[r]),) + t[1:] for t in residue_tests(res[judged], Cv[judged],
+                                                                                      row_P[judged])
+                                        for r in (t[0],))
     return MimoIdentificationResult(
         model=model, method=method, eta=xi, parameter_names=st.names, covariance=cov, converged=bool(converged),
         cost=float(cost), lines=np.concatenate(rows_list), experiment=np.concatenate(
@@ -382,5 +402,9 @@ def mimo_crb(model: MimoModel, inputs, *, noise, periods: int, lines=None, ka=No
         d = MimoFrequencyData(U=U[e], Y=Y, C=np.array(C) / periods, periods=periods, w0=model.w0, ts=model.ts)
         datas.append(d)
         rows_list.append(_rows_of(d, lines, st.K, e))
+        if rows_list[-1][0] <= st.K:
+            raise ValueError(f"lines: line {int(rows_list[-1][0])} is a row l <= K = {st.K}, which reads line 0 and "
+                             "conjugate lines, whose noise is not circular; the bound for several channels is that of "
+                             f"the circular complex likelihood: give rows from {st.K + 1}")
     F = fisher(core_data(datas, rows_list), core_structure(st), xi)
     return MimoCramerRaoBound(covariance=expand(np.linalg.inv(F), st), eta=xi, parameter_names=st.names)

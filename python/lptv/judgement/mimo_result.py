@@ -139,13 +139,123 @@ class MimoIdentificationResult:
         return not self.rejected
 
     @property
+    def undetermined(self) -> Optional[str]:
+        """Why the data do not determine the model or give no verdict (None when they do), as
+        :attr:`lptv.IdentificationResult.undetermined`: no noise statistics (noise-free data or
+        P < 2), or the identifiability warning (the generalised singular value ny^2 + 1 within
+        1.5 times value ny^2: a second parameter direction explains the data nearly as well)."""
+        if self.noise_free or not self.tests:
+            return "the data carry no noise statistics (noise-free or P < 2): the residues cannot be judged"
+        for w in self.warnings:
+            if "nearly unidentifiable" in w:
+                return "the data do not determine the model: " + w.split(": ", 1)[-1]
+        return None
+
+    @property
     def verdict(self) -> str:
+        """One sentence in the words of :attr:`lptv.IdentificationResult.verdict`: 'the model is
+        consistent with the noise: ...', 'MODEL ERRORS: the model is rejected: ...' or 'NOT
+        DETERMINED: ...'."""
         if self.model_ok is None:
-            return "no verdict: the data carry no noise statistics (noise-free or P < 2)"
+            return "NOT DETERMINED: " + self.undetermined
+        if self.model_ok and self.undetermined is None:
+            return (f"the model is consistent with the noise: the residues of all {self.n_outputs} outputs are at "
+                    f"the noise level (on the {len(self.judged_rows)} rows judged, {len(self.tests)} tests, Holm at "
+                    f"{ALPHA:g})")
         if self.model_ok:
-            return (f"consistent: the residues of all {self.n_outputs} outputs are at the noise level "
-                    f"({len(self.tests)} tests, Holm at {ALPHA:g})")
-        return "model error: " + "; ".join(self.model_errors[:3])
+            return "NOT DETERMINED: no sign of modelling errors, but " + self.undetermined
+        out = "MODEL ERRORS: the model is rejected: " + "; ".join(self.model_errors[:3])
+        return out + ("; and " + self.undetermined if self.undetermined else "")
+
+    @property
+    def judged_rows(self) -> np.ndarray:
+        """The indices of the rows the residue tests judge (rows l <= K, which read line 0 or a
+        conjugate line, are left out: their residues are not circular)."""
+        return np.unique([t[0] for t in self.tests]).astype(int) if self.tests else np.zeros(0, int)
+
+    def parameters(self, level: float = 0.95) -> list:
+        """One row per entry of ``eta``: ``name``, ``value``, ``std``, ``low``, ``high`` (the
+        two-sided ``level`` interval of :meth:`confidence_interval`) and ``kind`` ('normalised'
+        for the entries A_na,0 = I fixes, 'estimate' otherwise); ``std``, ``low``, ``high`` None
+        without a covariance.
+
+        Examples
+        --------
+        >>> from lptv.examples.mimo import small_fit
+        >>> row = small_fit().parameters()[0]
+        >>> row["name"], bool(row["low"] < 2.0 < row["high"])
+        ('a0[0,0].re0', True)
+        """
+        return parameter_rows(self.parameter_names, self.eta, self.covariance, level, self._fixed_names)
+
+    @property
+    def _fixed_names(self) -> frozenset:
+        """The entries the normalisation fixes: Re of harmonic 0 of every entry of A_na."""
+        na = self.model.na
+        return frozenset(n for n in self.parameter_names if n.startswith(f"a{na}[") and n.endswith(".re0"))
+
+    def summary(self, level: float = 0.95, units: Optional[dict] = None) -> str:
+        """The fit, its noise route, the parameters with their std and ``level`` intervals (each
+        coefficient entry's unit from ``units``, {'a0[0,1]': 'N/m', ...}, where given) and the
+        verdict, as :meth:`lptv.IdentificationResult.summary` prints them."""
+        lines = [f"method {self.method}: {self.n_free_parameters} free parameters on {self.lines.size} rows "
+                 f"({self.n_inputs} inputs, {self.n_outputs} outputs"
+                 + (f", {int(self.experiment.max()) + 1} experiments" if self.experiment.size
+                    and self.experiment.max() > 0 else "") + ")",
+                 f"iterations {self.iterations}, converged {self.converged}, cost {self.cost:.4g}"]
+        if self.noise_choice in ("", "asked for"):
+            lines.append(f"noise (co)variances: {self.noise} (asked for)")
+        else:
+            lines.append(f"noise (co)variances (noise='auto'): {self.noise_choice}")
+        if self.covariance is None:
+            head = (" (no covariance: noise-free data)" if self.noise_free else
+                    " (no covariance: covariance='none' or method 'gtls')")
+        else:
+            head = ""
+        lines.append("parameters" + head + ":")
+        lines.append(format_table(self.parameters(level), level, units))
+        lines.append(f"verdict: {self.verdict}")
+        lines += [f"warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+
+def parameter_rows(names, eta, covariance, level: float = 0.95, fixed=frozenset()) -> list:
+    """The rows of :meth:`MimoIdentificationResult.parameters` of any parameters ``eta`` named
+    ``names`` with ``covariance`` (or None); ``fixed``: the names set by the normalisation."""
+    from .._dist import norm_ppf
+
+    level = as_positive_float(level, "level")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level must be in (0, 1), got {level!r}")
+    z = norm_ppf(0.5 + level / 2.0)
+    std = None if covariance is None else np.sqrt(np.maximum(np.diag(covariance), 0.0))
+    rows = []
+    for i, name in enumerate(names):
+        s = None if std is None else float(std[i])
+        v = float(eta[i]) + 0.0                # -0.0 shown as 0
+        rows.append({"name": name, "value": v, "std": s, "low": None if s is None else v - z * s,
+                     "high": None if s is None else v + z * s,
+                     "kind": "normalised" if s == 0.0 or (s is None and name in fixed) else "estimate"})
+    return rows
+
+
+def format_table(rows, level: float = 0.95, units: Optional[dict] = None) -> str:
+    """The rows of :meth:`MimoIdentificationResult.parameters` as aligned text, the columns of
+    :func:`lptv.judgement.parameters.format_parameter_table`; ``units`` by coefficient entry
+    ('a0[0,1]') after each interval."""
+    width = max([12] + [len(r["name"]) for r in rows])
+    pct = f"{100 * level:g} %"
+    out = [f"  {'parameter':{width}s} {'value':>12s} {'std':>10s}   {pct + ' interval':>27s}"]
+    for r in rows:
+        if r["kind"] == "normalised":
+            out.append(f"  {r['name']:{width}s} {r['value']:12.6g} {'(normalised)':>10s}")
+        elif r["std"] is None:
+            out.append(f"  {r['name']:{width}s} {r['value']:12.6g}")
+        else:
+            unit = (units or {}).get(r["name"].split(".")[0], "")
+            out.append(f"  {r['name']:{width}s} {r['value']:12.6g} {r['std']:10.3g}   "
+                       f"[{r['low']:12.6g}, {r['high']:12.6g}]" + (f" {unit}" if unit else ""))
+    return "\n".join(out)
 
 
 def residue_tests(residue, covariance, periods) -> Tuple:
