@@ -99,6 +99,25 @@ def find(wanted: str, available: Sequence[str], role: str, kind: str, shown) -> 
     raise FileError(f"{kind} '{wanted}', the {word} named by {opt} ({kw}), is missing ({shown})")
 
 
+def distinct_channels(chosen, given, kind: str) -> None:
+    """FileError when channels named for different roles, or twice for one role, are one
+    channel of the file: ``chosen`` the file's names found, ``given`` the names as given, each
+    a sequence of (role, name) pairs in the same order ('force' and 'Force [N]' find one column)."""
+    seen = {}
+    for (role, name), (_, asked) in zip(chosen, given):
+        word, kw, opt = ROLES[role]
+        if name in seen:
+            role0, asked0 = seen[name]
+            w0_, kw0, opt0 = ROLES[role0]
+            how = f"'{asked0}' and '{asked}' name" if asked0 != asked else f"'{asked}' names"
+            if role0 == role:
+                raise FileError(f"{kw} ({opt}) names one {word} twice: {how} the {kind} '{name}'; name each "
+                                "channel once")
+            raise FileError(f"{kw0} ({opt0}) and {kw} ({opt}) name one {kind}: {how} '{name}', but the {w0_} "
+                            f"and the {word} must be different channels of the file")
+        seen[name] = (role, asked)
+
+
 def time_unit(name: str) -> Optional[float]:
     """Seconds per unit of a column named like a time (t, time, time [s], t_ms ...), else None."""
     m = _TIME.match(name.strip().lower())
@@ -229,8 +248,10 @@ def read_several(read_one, path, inputs, outputs, options: dict):
         if m.u.shape != first.u.shape or m.trimmed != first.trimmed:   # the same options on one file
             raise FileError(f"channels '{m.input}' and '{first.input}' differ in shape: "
                             f"{' x '.join(map(str, m.u.shape))} against {' x '.join(map(str, first.u.shape))}")
-    u = np.stack([reads[min(i, len(reads) - 1)].u for i in range(len(inputs))], axis=-1)
-    y = np.stack([reads[min(i, len(reads) - 1)].y for i in range(len(outputs))], axis=-1)
     names_u = tuple(reads[min(i, len(reads) - 1)].input for i in range(len(inputs)))
     names_y = tuple(reads[min(i, len(reads) - 1)].output for i in range(len(outputs)))
+    distinct_channels([("u", n) for n in names_u] + [("y", n) for n in names_y],
+                      [("u", n) for n in inputs] + [("y", n) for n in outputs], "channel")
+    u = np.stack([reads[min(i, len(reads) - 1)].u for i in range(len(inputs))], axis=-1)
+    y = np.stack([reads[min(i, len(reads) - 1)].y for i in range(len(outputs))], axis=-1)
     return dataclasses.replace(first, u=u, y=y, input=names_u, output=names_y)

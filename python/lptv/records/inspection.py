@@ -32,6 +32,10 @@ __all__ = ["Inspection", "LineClass", "inspect"]
 OUTPUT_REPEAT_LIMIT = 0.5
 """The output repeats with the input when its repeat residue is below this (its repeating part
 holds more power than its noise)."""
+SWAPPED_DB = 10.0
+"""The input's median SNR on the excited lines this far below the output's asks whether input and
+output are swapped: an excitation is measured where it is made, mostly the cleaner of the two,
+while the output carries the system's filtering (:attr:`Inspection.swapped`)."""
 WEAK_INPUT_DB = 40.0
 """Input lines above the noise but this far below the median excited line are not counted as
 excitation (an actuator's distortion, leakage), only reported."""
@@ -170,6 +174,20 @@ class Inspection:
                 return True
         return self.time_variation_reach > 0
 
+    @property
+    def swapped(self) -> Optional[str]:
+        """A sentence asking whether input and output are swapped, when the input's median SNR on
+        the excited lines is :data:`SWAPPED_DB` or more below the output's; else None."""
+        if not self.lines.size:
+            return None
+        si, so = float(np.median(self.input_snr_db)), float(np.median(self.output_snr_db))
+        if not (np.isfinite(si) and np.isfinite(so)) or si > so - SWAPPED_DB:
+            return None
+        return (f"the input '{self.input}' is the noisier channel: its median SNR on the excited lines is "
+                f"{si:.0f} dB against the output's {so:.0f} dB; an excitation is mostly measured cleaner than "
+                f"the response: are input and output swapped? (--input '{self.output}' --output "
+                f"'{self.input}' if so)")
+
     def line_class(self, name: str) -> LineClass:
         return next(c for c in self.classes if c.name == name)
 
@@ -262,7 +280,7 @@ class Inspection:
             out.append(f"  {_CLASS_TITLE[c.name](self.reach):<26} {c.above.size} of {c.lines.size} lines above the noise"
                        + (f", strongest {c.level_db:+.1f} dB from the excited lines' output" if c.present else "")
                        + f": {self._meaning(c)}")
-        out += [f"note:        {n}" for n in self.notes]
+        out += [f"note:        {n}" for n in self.notes + ((self.swapped,) if self.swapped else ())]
         out.append("suggested:   " + self.command)
         out.append("             (NA, NB: the orders of the model"
                    + ("" if self.sidebands_visible else ", K: its harmonics, which this excitation cannot show")

@@ -34,8 +34,8 @@ import numpy as np
 
 from .._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
 from .check import RecordCheck, RecordWarning, check_record, detrended  # noqa: F401 - lptv.records.measurements.*
-from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, find, fs_from_time, listing,
-                       read_several, several_channels, stored_fs, time_unit)
+from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, distinct_channels, find,
+                       fs_from_time, listing, read_several, several_channels, stored_fs, time_unit)
 
 FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
 _MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
@@ -361,6 +361,7 @@ def _read_csv(path, names):
                             "in the header")
         cols[role] = heads.index(name)
     chosen = (heads[cols["u"]], heads[cols["y"]])
+    distinct_channels([("u", chosen[0]), ("y", chosen[1])], [("u", names["u"]), ("y", names["y"])], "column")
     t_name = find(names["time"], heads, "time", "column", shown) if names["time"] else auto_time(heads, chosen)
     if t_name is not None and t_name not in chosen:
         cols["time"] = heads.index(t_name)
@@ -598,6 +599,7 @@ def _wanted(names, available, kind, shown):
     """The file's names of u, y and (if any) the time, and the sampling variables present."""
     u = find(names["u"], available, "u", kind, shown)
     y = find(names["y"], available, "y", kind, shown)
+    distinct_channels([("u", u), ("y", y)], [("u", names["u"]), ("y", names["y"])], kind)
     t = find(names["time"], available, "time", kind, shown) if names["time"] else auto_time(available, (u, y))
     extra = [n for n in FS_NAMES + DT_NAMES + ("w0",) if n in available and n not in (u, y)]
     return u, y, t, extra
