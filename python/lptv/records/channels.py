@@ -42,16 +42,23 @@ def channel_name(x, role):
     if isinstance(x, (list, tuple)) and len(x) == 1 and role != "time":
         x = x[0]      # a list of one channel: the one-channel reader (several: several_channels)
     if role == "y" and isinstance(x, (list, tuple)) and len(x) > 1 and all(isinstance(v, str) for v in x):
-        raise FileError(one_output_message(list(x)))
+        raise FileError(one_output_message(list(x), as_list=True))
     if not isinstance(x, str) or not x.strip():
         raise FileError(f"{kw} ({opt}) must name a channel of the file (a non-empty str), got {x!r}")
     return x.strip()
 
 
-def one_output_message(names):
+def one_output_message(names, as_list=False):
+    """A comma name where one channel is read; ``as_list``: a list given to a reader of one pair
+    (lptv.inspect)."""
     listed = ", ".join(repr(n) for n in names)
-    return (f"y= (--output) must name one output channel, got {len(names)} ({listed}): lptv fits one output "
-            "at a time (MIMO models are not supported yet); run once per output channel")
+    if as_list:
+        return (f"y= (--output) must name one output channel here, got {len(names)} ({listed}): lptv.inspect "
+                f"reads one input and one output; inspect each pair (lptv inspect FILE --output "
+                f"{','.join(names)} does it pair by pair)")
+    return (f"y= (--output) names one output channel here, got {len(names)} in one name ({listed}): several "
+            f"outputs are a list, y=[{listed}] (--output {','.join(names)} on the command line), read as "
+            "(P, N, ny) arrays and fitted as one MimoModel")
 
 
 def split_unit(name: str) -> Tuple[str, Optional[str]]:
