@@ -292,9 +292,14 @@ class Inspection:
             k = self.time_variation_reach
             if k:
                 far = " or farther" if k == self.reach else ""
-                where = "" if c.present else ", seen on the detection lines next to the excited ones"
-                return (f"the system varies in time: sidebands reach +-{k} lines{far}{where} (harmonics "
-                        f"K >= {k}; or nonlinear distortion there)")
+                span = f"{k} line" + ("" if k == 1 else "s")
+                if c.present:
+                    return (f"the system varies in time: sidebands reach +-{span}{far} (harmonics K >= {k}; or "
+                            "nonlinear distortion there)")
+                # the lines up to k from the excited ones that stand above the noise are detection lines
+                return (f"none here, but the detection lines up to {span}{' or more' if far else ''} from the "
+                        f"excited ones stand above the noise: time variation (harmonics K >= {k}), or nonlinear "
+                        "distortion on those lines")
             if not self.sidebands_visible:
                 return ("no unexcited line between the excited ones: time variation, if any, hides under them "
                         "(the fit's verdict or lptv.htf_estimate tells)")
@@ -320,7 +325,7 @@ class Inspection:
 
 
 _CLASS_TITLE = {
-    "sidebands": lambda K: f"sidebands (+-1..{K}):",
+    "sidebands": lambda K: f"sidebands (+-1..{K}):" if K > 1 else "sidebands (+-1):",
     "odd detection": lambda K: "odd detection lines:",
     "even detection": lambda K: "even detection lines:",
     "elsewhere": lambda K: "elsewhere:",
