@@ -66,7 +66,7 @@ CCACHE_LAUNCH = $(if $(shell command -v ccache),ccache,)
 define apt_install
 	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
-	  echo "apt-get install:$$missing"; \
+	  echo "installing Debian packages (apt-get, a few minutes):$$missing"; \
 	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
 	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
 	fi
@@ -87,15 +87,20 @@ PINS_STAMP := $(VENV)/.pins-$(shell echo '$(PIP_PINS)' | md5sum | cut -c1-12)
 DEMO_STAMP := $(VENV)/.demo-pins-$(shell echo '$(PIP_DEMO_PINS)' | md5sum | cut -c1-12)
 
 $(PINS_STAMP):
-	@test -x $(PY) || python3 -m venv $(VENV)
+	@test -x $(PY) || { echo "creating the Python environment $(VENV)/"; python3 -m venv $(VENV); }
 	@rm -f $(VENV)/.pins-*
+	@echo "installing the pinned Python packages into $(VENV)/ (the tests' and the benchmarks' too):" \
+	  "$(foreach p,$(PIP_PINS),$(firstword $(subst ==, ,$(p))))"
 	$(PIP) install -qq --disable-pip-version-check $(PIP_PINS)
 	@touch $@
 
 $(DEMO_STAMP):
-	@test -x $(PY) || python3 -m venv $(VENV)
+	@test -x $(PY) || { echo "creating the Python environment $(VENV)/"; python3 -m venv $(VENV); }
 	@rm -f $(VENV)/.demo-pins-*
-	@if [ -e $(PINS_STAMP) ]; then :; else $(PIP) install -qq --disable-pip-version-check $(PIP_DEMO_PINS); fi
+	@if [ -e $(PINS_STAMP) ]; then :; else \
+	  echo "installing the pinned Python packages into $(VENV)/ (a minute or two):" \
+	    "$(foreach p,$(PIP_DEMO_PINS),$(firstword $(subst ==, ,$(p))))"; \
+	  $(PIP) install -qq --disable-pip-version-check $(PIP_DEMO_PINS); fi
 	@touch $@
 
 venv: $(PINS_STAMP)
@@ -132,6 +137,8 @@ consumer: cpp
 # The Python package into the venv; with the demo's packages only (make demo), the tests' and
 # benchmarks' targets add the rest (venv).
 python: deps-build venv-demo
+	@echo "building and installing the Python package lptv into $(VENV)/ (the C++ core and its module:" \
+	  "several minutes the first time, seconds once ccache holds them)"
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -q --disable-pip-version-check \
 	  --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE_LAUNCH) .
 
@@ -241,6 +248,7 @@ stubs: venv python
 
 # Installs only what the demo uses: APT_BUILD and PIP_DEMO_PINS (no browser, no test tools).
 demo: python
+	@echo "running lptv demo (the paper's example; a few minutes)"
 	$(VENV)/bin/lptv demo
 
 bench: deps-bench venv python

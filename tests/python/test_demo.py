@@ -88,3 +88,12 @@ def test_demo_report_shows_the_verdict_and_the_parameters_with_their_std(demo_ou
         assert float(z) == pytest.approx((float(sm) - float(true)) / float(s_sm), abs=0.05)
     s = json.loads((demo_out / "summary.json").read_text())
     assert np.mean([abs(float(r[6])) <= 2.0 for r in free]) == pytest.approx(s["sml_within_2_sigma"], abs=1.5 / 34)
+
+
+def test_demo_states_the_fds_against_cvode_gap_once_with_its_sign(demo_out):
+    """summary.json keeps the level (dB relative to the output peak, negative); the report says
+    "228.5 dB below the output peak", never "-228.5 dB below"."""
+    s = json.loads((demo_out / "summary.json").read_text())
+    html = (demo_out / "report.html").read_text()
+    assert f"{-s['fds_vs_cvode_db']:.1f} dB below the output peak" in html
+    assert f"{s['fds_vs_cvode_db']:.1f} dB" not in html

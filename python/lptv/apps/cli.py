@@ -70,7 +70,57 @@ def _version() -> str:
         return "(not installed: running from a source tree)"
 
 
+class _ClosedPipeSafe:
+    """A standard stream that survives its reader going away (``lptv inspect ... | head``): the
+    first write or flush that meets a closed pipe sends the stream to /dev/null, so that the
+    command finishes its work (its files on disk, its exit status) with no traceback, as it would
+    with nobody reading its output."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _closed(self):
+        import os
+
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, self._stream.fileno())   # the buffer's flush at exit goes there too
+            os.close(devnull)
+        except (OSError, ValueError, AttributeError):
+            pass
+
+    def write(self, text):
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._closed()
+            return len(text)
+
+    def flush(self):
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._closed()
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
+    """The ``lptv`` command; its exit status. Its output may go to a reader that stops early
+    (``| head``): what is left is not printed, the rest of the work is done."""
+    streams = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = (_ClosedPipeSafe(s) if s is not None else s for s in streams)
+    try:
+        return _main(argv)
+    finally:     # --help's SystemExit included: what is buffered meets the closed pipe here
+        for s in (sys.stdout, sys.stderr):
+            if isinstance(s, _ClosedPipeSafe):
+                s.flush()
+        sys.stdout, sys.stderr = streams
+
+
+def _main(argv=None) -> int:
     from lptv.apps.options import Parser
 
     parser = Parser(

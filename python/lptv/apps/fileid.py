@@ -295,8 +295,12 @@ def run(args) -> int:
         return _fail(src, e)
     # identify's own warnings are in res.warnings (and so in its summary); keep the others
     transient = inspectrec.transient_note(diag, meas.u.shape[-1], meas.skipped, res.model_ok)
+    multiple = inspectrec.period_multiple_note(diag, args, meas.u.shape[-1], res.model_ok)
+    swapped = diag.swapped if diag is not None and diag.repeats and not res.model_ok \
+        and getattr(args, "reference", None) is None else None
     extra = ([f"{checked} (kept by --no-period-check)"] if checked else []) \
-        + ([output_note] if output_note else []) + ([transient] if transient else []) \
+        + ([output_note] if output_note else []) + ([multiple] if multiple else []) \
+        + ([transient] if transient else []) + ([swapped] if swapped else []) \
         + [m for m in record.messages if not (transient and "transient" in m)] \
         + [str(w.message) for w in caught if str(w.message) not in res.warnings]
 

@@ -16,7 +16,9 @@ import shlex
 from pathlib import Path
 
 from lptv import inspect
+from lptv.apps.options import count
 from lptv.apps.report import PLOTS_EXTRA, Report, write_json
+from lptv.records.channels import distinct_channels
 
 
 def _names(text, default):
@@ -76,12 +78,18 @@ def run(args, summary_of, report_of, fail) -> int:
         outputs = _names(args.output, "y")
         pairs = [(u, outputs[0]) for u in inputs] + [(inputs[0], y) for y in outputs[1:]]
         insps = [inspect(src, u=u, y=y, time=args.time, fs=args.fs, dt=args.dt, reach=args.reach) for u, y in pairs]
+        # each channel read once: 'f1' and 'F1 [N]' find one column, as the reader of lptv identify refuses
+        found = [i.input for i in insps[:len(inputs)]] + [insps[0].output] + [i.output for i in insps[len(inputs):]]
+        roles = ["u"] * len(inputs) + ["y"] * len(outputs)
+        distinct_channels(list(zip(roles, found)), list(zip(roles, inputs + outputs)),
+                          "column" if insps[0].format == "CSV" else "variable")
     except ValueError as e:
         return fail(src, e)
     period, finding = common_period(insps)
     cmd = command(insps, period, src, [i.input for i in insps[:len(inputs)]],
                   [insps[0].output] + [i.output for i in insps[len(inputs):]]) if period else None
-    lines = [f"lptv inspect: {src}: {len(inputs)} inputs, {len(outputs)} outputs, inspected in {len(pairs)} pairs"]
+    lines = [f"lptv inspect: {src}: {count(len(inputs), 'input')}, {count(len(outputs), 'output')}, inspected in "
+             f"{count(len(pairs), 'pair')}"]
     for k, insp in enumerate(insps):
         lines.append("")
         lines.append(f"== pair {k}: input '{insp.input}', output '{insp.output}' ==")
@@ -104,7 +112,8 @@ def run(args, summary_of, report_of, fail) -> int:
                                           "outputs": [insps[0].output] + [i.output for i in insps[len(inputs):]],
                                           "period_samples": period, "finding": finding, "command": cmd,
                                           "pairs": [summary_of(i) for i in insps]})
-        rep = Report(f"lptv inspect: {Path(src).name} ({len(inputs)} inputs, {len(outputs)} outputs)")
+        rep = Report(f"lptv inspect: {Path(src).name} ({count(len(inputs), 'input')}, "
+                     f"{count(len(outputs), 'output')})")
         rep.paragraph(f"All channels: {finding}." + (f" Suggested: {cmd}" if cmd else ""))
         rep.paragraph("Each input was inspected with the first output, each further output with the first "
                       "input; each pair's report, with its figure, is in pair<k>/report.html.")

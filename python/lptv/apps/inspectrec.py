@@ -124,7 +124,7 @@ def summary(insp) -> dict:
         "reach": insp.reach, "time_variation_reach": insp.time_variation_reach,
         "classes": {c.name: {"lines": int(c.lines.size), "above_noise": c.above.tolist(),
                              "excess_db": c.excess_db, "strongest_db": c.level_db} for c in insp.classes},
-        "notes": list(insp.notes), "command": insp.command,
+        "notes": list(insp.notes), "swapped": insp.swapped, "command": insp.command,
     }
 
 
@@ -250,6 +250,43 @@ def output_period_note(insp, samples_per_period):
     return (f"the output repeats only every {insp.seconds(insp.period_samples)}, every "
             f"{insp.period_samples // insp.input_period_samples} of the input's periods: the system's period is "
             f"probably that one ({fix})")
+
+
+def period_multiple_note(insp, args, samples_per_period, model_ok: bool = True):
+    """A warning when the record is cut into periods that hold several of the ones input and output
+    repeat at (``--period 8`` on a record repeating every 4 s, or a wrong ``--fs`` on a file
+    without a time): the fit then reads the system's harmonics as multiples of a lower w0, and a
+    time-varying model with a harmonic count for the true period misses them (MODEL ERRORS).
+    None when the periods are the record's own."""
+    if insp is None or not insp.repeats or not insp.output_agrees_with(samples_per_period):
+        return None
+    own = insp.input_period_exact * (insp.period_samples // insp.input_period_samples)
+    m = int(round(samples_per_period / own))
+    if m < 2:
+        return None
+    opt = period_option(args)
+    lead = "the verdict's model errors may be the period's: " if not model_ok else ""
+    found = f"input and output repeat every {insp.seconds(insp.period_samples)}"
+    true = f"{insp.period:.6g} s" if insp.period is not None else f"{insp.period_samples:g} samples"
+    if opt is not None and insp.file_fs is not None:
+        said = f"{opt[0]} holds {m} of the record's periods ({found} at the {insp.fs:g} Hz of the file's " \
+               f"{insp.file_fs_source})"
+        fix = f"use --period {insp.period:.12g}"
+    elif opt is not None and insp.fs is not None:
+        fs = insp.fs
+        said = (f"{opt[0]} at --fs {fs:g} is {samples_per_period:g} samples, {m} of the record's periods "
+                f"({found} at that fs)")
+        fix = (f"use --period {insp.period:.12g} at this fs, or correct --fs ({insp.period_samples:g} samples in "
+               f"{opt[1]:g} s is {insp.period_samples / opt[1]:.6g} Hz)")
+    elif getattr(args, "periods", None) is not None:
+        said = f"--periods {args.periods} cuts the record into periods of {m} of its own ({found})"
+        fix = f"use --periods {insp.periods}"
+    else:
+        said = f"each period of the file holds {m} of the record's periods ({found})"
+        fix = f"store periods of {insp.period_samples:g} samples"
+    return (f"{lead}{said}: the system's period is probably {true}, and at the fit's period a time-varying "
+            f"model needs {m} times the harmonics for the same variation ({fix}; keep the fit's period only if "
+            "the system's own period is that long)")
 
 
 def failure_cause(insp, args, samples_per_period=None):

@@ -34,7 +34,7 @@ import numpy as np
 
 import lptv
 from lptv import NumericalError
-from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, fundamental, in_option_terms, integer,
+from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, count, fundamental, in_option_terms, integer,
                                output_folder, parse_counts, parse_lines, positive, read_options)
 from lptv.apps import inspectrec, units
 from lptv.apps.report import write_fit
@@ -187,12 +187,12 @@ def run(args) -> int:
         return _fail(e)
 
     out = Path(args.out) if args.out else Path(Path(files[0]).stem + "-lptv")
-    print(f"lptv identify: {len(files)} experiment{'s' if len(files) > 1 else ''}, "
-          f"{res.model.n_inputs} inputs ({', '.join(first.input)}), {res.model.n_outputs} outputs "
+    print(f"lptv identify: {count(len(files), 'experiment')}, "
+          f"{count(res.model.n_inputs, 'input')} ({', '.join(first.input)}), {count(res.model.n_outputs, 'output')} "
           f"({', '.join(first.output)}), w0 = {w0:.6g} rad/s"
           + (f", discrete-time model with ts = {ts:g} s" if ts else ", continuous-time model") + f" -> {out}/")
     for e, (src, meas) in enumerate(records):
-        print(f"  #{e} {src} ({meas.format}): {meas.u.shape[0]} periods of {meas.u.shape[1]} samples")
+        print(f"  #{e} {src} ({meas.format}): {count(meas.u.shape[0], 'period')} of {meas.u.shape[1]} samples")
     print(text_summary(res, u_units, y_units))
     if physical is not None:
         print(physical_text(physical, u_units, y_units))

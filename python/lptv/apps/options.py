@@ -342,11 +342,16 @@ def read_record(src, args, realisations: bool = False):
     return read_measurements(src, **read_options(args), realisations=realisations)
 
 
+def count(n: int, word: str) -> str:
+    """'1 input', '2 inputs', '1 period', '0 samples': a count with its noun in number."""
+    return f"{n} {word}" + ("" if n == 1 else "s")
+
+
 def dropped_note(meas):
     """'dropped at the start: 40 samples (--trim), 6 periods (--skip-periods)', naming only what
     was dropped; None when nothing was."""
-    parts = ([f"{meas.trimmed} sample{'s' * (meas.trimmed != 1)} (--trim)"] if meas.trimmed else []) \
-        + ([f"{meas.skipped} period{'s' * (meas.skipped != 1)} (--skip-periods)"] if meas.skipped else [])
+    parts = ([f"{count(meas.trimmed, 'sample')} (--trim)"] if meas.trimmed else []) \
+        + ([f"{count(meas.skipped, 'period')} (--skip-periods)"] if meas.skipped else [])
     return "dropped at the start: " + ", ".join(parts) if parts else None
 
 

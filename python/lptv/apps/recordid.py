@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from lptv import NumericalError, identify_record, read_measurements
-from lptv.apps.options import in_option_terms, integer, output_folder, refuse_given
+from lptv.apps.options import count, in_option_terms, integer, output_folder, refuse_given
 from lptv.apps.report import Report, write_json
 from lptv.apps import units
 from lptv.records.measurements import FileError
@@ -113,9 +113,10 @@ def run(args, names=None) -> int:
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
     out.mkdir(parents=True, exist_ok=True)
     L, N0 = meas.u.shape
-    dropped = ([f"{meas.trimmed} samples"] if meas.trimmed else []) \
-        + ([f"{meas.skipped} periods (--skip-periods)"] if meas.skipped else [])
-    print(f"lptv identify: {src} ({meas.format}, one record of {L} periods of {N0} samples, fs = {meas.fs:g} Hz, "
+    dropped = ([count(meas.trimmed, "sample")] if meas.trimmed else []) \
+        + ([f"{count(meas.skipped, 'period')} (--skip-periods)"] if meas.skipped else [])
+    print(f"lptv identify: {src} ({meas.format}, one record of {count(L, 'period')} of {N0} samples, "
+          f"fs = {meas.fs:g} Hz, "
           f"{'discrete' if discrete else 'continuous'}-time model, {res.lines.size} lines"
           + (f", {' and '.join(dropped)} dropped at the start" if dropped else "") + ")")
     print(f"  verdict: {res.verdict}")
@@ -176,7 +177,8 @@ def _report(res, src, L, N0, fs, discrete, u_unit=None, y_unit=None) -> Report:
     import matplotlib.pyplot as plt
 
     rep = Report("lptv identify: one record")
-    rep.paragraph(f"{src}: one record of {L} periods of {N0} samples at {fs:g} Hz, fitted with its transient "
+    rep.paragraph(f"{src}: one record of {count(L, 'period')} of {N0} samples at {fs:g} Hz, fitted with its "
+                  "transient "
                   f"(output-error maximum likelihood, {'discrete' if discrete else 'continuous'}-time model) on "
                   f"{res.lines.size} lines of the record's grid.")
     rep.heading("Verdict")

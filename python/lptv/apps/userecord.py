@@ -15,7 +15,7 @@ import numpy as np
 from lptv import MimoModel, Model, read_measurements
 from lptv.apps.options import in_option_terms, positive
 from lptv.records.channels import split_unit
-from lptv.records.measurements import FileError
+from lptv.records.measurements import FileError, read_input
 from lptv.use.predict import whole_periods
 
 
@@ -133,12 +133,15 @@ def read(args, model, *, output=True, periodic=True):
     # lptv identify --one-record reads it: whole periods of the model, its first samples dropped to keep them
     kw.update(periods=args.periods, trim=args.trim, skip_periods=args.skip_periods) if periodic else \
         kw.update(trim=True)
+    reader = read_measurements if output else read_input    # simulate: a record of the input alone
+    if not output:
+        del kw["y"]
     try:
-        meas = read_measurements(args.file, fs=fs, **kw)
+        meas = reader(args.file, fs=fs, **kw)
     except FileError:
         if fs is not None or fallback is None:
             raise
-        meas = read_measurements(args.file, fs=fallback, **kw)    # no time of its own: sampled as the model's
+        meas = reader(args.file, fs=fallback, **kw)    # no time of its own: sampled as the model's
     fs, source = (meas.fs, meas.fs_source) if meas.fs is not None else (fallback, "the model")
     if fs is None:
         raise FileError("the sampling frequency is unknown: give --fs (the file has no time column or stored fs, "
@@ -156,7 +159,7 @@ def time_column(args, meas, fs):
     src = meas.fs_source or ""
     hit = re.match(r"(?:column|variable) '(.+)'$", src)
     if hit:
-        t = np.asarray(read_measurements(args.file, fs=fs, period=meas.w0 and 2 * np.pi / meas.w0, trim=True,
-                                         u=hit.group(1), y=hit.group(1)).u).reshape(-1)
+        t = np.asarray(read_input(args.file, fs=fs, period=meas.w0 and 2 * np.pi / meas.w0, trim=True,
+                                  u=hit.group(1)).u).reshape(-1)
         return hit.group(1), t[t.size - n:]
     return "time [s]", np.arange(n) / fs

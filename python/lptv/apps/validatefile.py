@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from lptv import NumericalError, validate
-from lptv.apps.options import MODEL_REJECTED, output_folder, parse_lines
+from lptv.apps.options import MODEL_REJECTED, count, dropped_note, output_folder, parse_lines
 from lptv.apps.report import Report, write_json
 from lptv.apps.userecord import add_model_and_record, fail, load_model, read, time_column
 from lptv.records.measurements import FileError
@@ -67,13 +67,13 @@ def run(args) -> int:
     except (FileError, ValueError) as e:
         return fail("validate", args.file, e)
     out = Path(args.out) if args.out else Path(Path(args.file).stem + "-validate")
-    shape = "one record" if args.one_record else f"{meas.u.shape[0]} periods of {meas.u.shape[1]} samples"
+    shape = "one record" if args.one_record else f"{count(meas.u.shape[0], 'period')} of {meas.u.shape[1]} samples"
     fits = np.atleast_1d(res.fit_percent)
     outputs = list(model.context["outputs"]) if model.context else [f"y{i + 1}" for i in range(fits.size)]
     print(f"lptv validate: {args.model} against {args.file} ({shape}, fs = {fs:g} Hz from {source or '--fs'}; "
           f"the model fixed) -> {out}/")
-    if meas.trimmed or meas.skipped:
-        print(f"  dropped at the start: {meas.trimmed} samples, {meas.skipped} periods")
+    if dropped_note(meas):
+        print(f"  {dropped_note(meas)}")
     print(f"  verdict: {res.verdict}")
     for name, f in zip(outputs, fits):
         print(f"  simulation fit of {name}: {f:.2f} %")

@@ -42,16 +42,23 @@ def channel_name(x, role):
     if isinstance(x, (list, tuple)) and len(x) == 1 and role != "time":
         x = x[0]      # a list of one channel: the one-channel reader (several: several_channels)
     if role == "y" and isinstance(x, (list, tuple)) and len(x) > 1 and all(isinstance(v, str) for v in x):
-        raise FileError(one_output_message(list(x)))
+        raise FileError(one_output_message(list(x), as_list=True))
     if not isinstance(x, str) or not x.strip():
         raise FileError(f"{kw} ({opt}) must name a channel of the file (a non-empty str), got {x!r}")
     return x.strip()
 
 
-def one_output_message(names):
+def one_output_message(names, as_list=False):
+    """A comma name where one channel is read; ``as_list``: a list given to a reader of one pair
+    (lptv.inspect)."""
     listed = ", ".join(repr(n) for n in names)
-    return (f"y= (--output) must name one output channel, got {len(names)} ({listed}): lptv fits one output "
-            "at a time (MIMO models are not supported yet); run once per output channel")
+    if as_list:
+        return (f"y= (--output) must name one output channel here, got {len(names)} ({listed}): lptv.inspect "
+                f"reads one input and one output; inspect each pair (lptv inspect FILE --output "
+                f"{','.join(names)} does it pair by pair)")
+    return (f"y= (--output) names one output channel here, got {len(names)} in one name ({listed}): several "
+            f"outputs are a list, y=[{listed}] (--output {','.join(names)} on the command line), read as "
+            "(P, N, ny) arrays and fitted as one MimoModel")
 
 
 def split_unit(name: str) -> Tuple[str, Optional[str]]:
@@ -97,6 +104,25 @@ def find(wanted: str, available: Sequence[str], role: str, kind: str, shown) -> 
         raise FileError(f"{kind} '{wanted}' is missing ({shown}); name the input and output channels with "
                         "--input NAME --output NAME (u=, y= of lptv.read_measurements)")
     raise FileError(f"{kind} '{wanted}', the {word} named by {opt} ({kw}), is missing ({shown})")
+
+
+def distinct_channels(chosen, given, kind: str) -> None:
+    """FileError when channels named for different roles, or twice for one role, are one
+    channel of the file: ``chosen`` the file's names found, ``given`` the names as given, each
+    a sequence of (role, name) pairs in the same order ('force' and 'Force [N]' find one column)."""
+    seen = {}
+    for (role, name), (_, asked) in zip(chosen, given):
+        word, kw, opt = ROLES[role]
+        if name in seen:
+            role0, asked0 = seen[name]
+            w0_, kw0, opt0 = ROLES[role0]
+            how = f"'{asked0}' and '{asked}' name" if asked0 != asked else f"'{asked}' names"
+            if role0 == role:
+                raise FileError(f"{kw} ({opt}) names one {word} twice: {how} the {kind} '{name}'; name each "
+                                "channel once")
+            raise FileError(f"{kw0} ({opt0}) and {kw} ({opt}) name one {kind}: {how} '{name}', but the {w0_} "
+                            f"and the {word} must be different channels of the file")
+        seen[name] = (role, asked)
 
 
 def time_unit(name: str) -> Optional[float]:
@@ -229,8 +255,10 @@ def read_several(read_one, path, inputs, outputs, options: dict):
         if m.u.shape != first.u.shape or m.trimmed != first.trimmed:   # the same options on one file
             raise FileError(f"channels '{m.input}' and '{first.input}' differ in shape: "
                             f"{' x '.join(map(str, m.u.shape))} against {' x '.join(map(str, first.u.shape))}")
-    u = np.stack([reads[min(i, len(reads) - 1)].u for i in range(len(inputs))], axis=-1)
-    y = np.stack([reads[min(i, len(reads) - 1)].y for i in range(len(outputs))], axis=-1)
     names_u = tuple(reads[min(i, len(reads) - 1)].input for i in range(len(inputs)))
     names_y = tuple(reads[min(i, len(reads) - 1)].output for i in range(len(outputs)))
+    distinct_channels([("u", n) for n in names_u] + [("y", n) for n in names_y],
+                      [("u", n) for n in inputs] + [("y", n) for n in outputs], "channel")
+    u = np.stack([reads[min(i, len(reads) - 1)].u for i in range(len(inputs))], axis=-1)
+    y = np.stack([reads[min(i, len(reads) - 1)].y for i in range(len(outputs))], axis=-1)
     return dataclasses.replace(first, u=u, y=y, input=names_u, output=names_y)

@@ -32,6 +32,10 @@ __all__ = ["Inspection", "LineClass", "inspect"]
 OUTPUT_REPEAT_LIMIT = 0.5
 """The output repeats with the input when its repeat residue is below this (its repeating part
 holds more power than its noise)."""
+SWAPPED_DB = 10.0
+"""The input's median SNR on the excited lines this far below the output's asks whether input and
+output are swapped: an excitation is measured where it is made, mostly the cleaner of the two,
+while the output carries the system's filtering (:attr:`Inspection.swapped`)."""
 WEAK_INPUT_DB = 40.0
 """Input lines above the noise but this far below the median excited line are not counted as
 excitation (an actuator's distortion, leakage), only reported."""
@@ -176,6 +180,20 @@ class Inspection:
                 return True
         return self.time_variation_reach > 0
 
+    @property
+    def swapped(self) -> Optional[str]:
+        """A sentence asking whether input and output are swapped, when the input's median SNR on
+        the excited lines is :data:`SWAPPED_DB` or more below the output's; else None."""
+        if not self.lines.size:
+            return None
+        si, so = float(np.median(self.input_snr_db)), float(np.median(self.output_snr_db))
+        if not (np.isfinite(si) and np.isfinite(so)) or si > so - SWAPPED_DB:
+            return None
+        return (f"the input '{self.input}' is the noisier channel: its median SNR on the excited lines is "
+                f"{si:.0f} dB against the output's {so:.0f} dB; an excitation is mostly measured cleaner than "
+                f"the response: are input and output swapped? (--input '{self.output}' --output "
+                f"'{self.input}' if so)")
+
     def line_class(self, name: str) -> LineClass:
         return next(c for c in self.classes if c.name == name)
 
@@ -274,7 +292,7 @@ class Inspection:
             out.append(f"  {_CLASS_TITLE[c.name](self.reach):<26} {c.above.size} of {c.lines.size} lines above the noise"
                        + (f", strongest {c.level_db:+.1f} dB from the excited lines' output" if c.present else "")
                        + f": {self._meaning(c)}")
-        out += [f"note:        {n}" for n in self.notes]
+        out += [f"note:        {n}" for n in self.notes + ((self.swapped,) if self.swapped else ())]
         out.append("suggested:   " + self.command)
         out.append("             (NA, NB: the orders of the model"
                    + ("" if self.sidebands_visible else ", K: its harmonics, which this excitation cannot show")
@@ -286,9 +304,14 @@ class Inspection:
             k = self.time_variation_reach
             if k:
                 far = " or farther" if k == self.reach else ""
-                where = "" if c.present else ", seen on the detection lines next to the excited ones"
-                return (f"the system varies in time: sidebands reach +-{k} lines{far}{where} (harmonics "
-                        f"K >= {k}; or nonlinear distortion there)")
+                span = f"{k} line" + ("" if k == 1 else "s")
+                if c.present:
+                    return (f"the system varies in time: sidebands reach +-{span}{far} (harmonics K >= {k}; or "
+                            "nonlinear distortion there)")
+                # the lines up to k from the excited ones that stand above the noise are detection lines
+                return (f"none here, but the detection lines up to {span}{' or more' if far else ''} from the "
+                        f"excited ones stand above the noise: time variation (harmonics K >= {k}), or nonlinear "
+                        "distortion on those lines")
             if not self.sidebands_visible:
                 return ("no unexcited line between the excited ones: time variation, if any, hides under them "
                         "(the fit's verdict or lptv.htf_estimate tells)")
@@ -314,7 +337,7 @@ class Inspection:
 
 
 _CLASS_TITLE = {
-    "sidebands": lambda K: f"sidebands (+-1..{K}):",
+    "sidebands": lambda K: f"sidebands (+-1..{K}):" if K > 1 else "sidebands (+-1):",
     "odd detection": lambda K: "odd detection lines:",
     "even detection": lambda K: "even detection lines:",
     "elsewhere": lambda K: "elsewhere:",

@@ -23,6 +23,8 @@ Examples
 """
 from __future__ import annotations
 
+import contextvars
+
 import csv
 import io
 import os
@@ -34,8 +36,8 @@ import numpy as np
 
 from .._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
 from .check import RecordCheck, RecordWarning, check_record, detrended  # noqa: F401 - lptv.records.measurements.*
-from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, find, fs_from_time, listing,
-                       read_several, several_channels, stored_fs, time_unit)
+from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, distinct_channels, find,
+                       fs_from_time, listing, read_several, several_channels, stored_fs, time_unit)
 
 FORMATS = {".csv": "CSV", ".npz": "NPZ", ".mat": "MAT"}
 _MATLAB_NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32",
@@ -224,8 +226,10 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
     if skip_periods:
         P = u_p.shape[-2]
         if P - skip_periods < 2:
-            raise FileError(f"--skip-periods {skip_periods} leaves {P - skip_periods} of "
-                            f"{P} periods; the noise model needs at least 2")
+            left = (f"leaves {P - skip_periods} of the record's {P} periods" if skip_periods < P else
+                    f"drops {'all' if skip_periods == P else 'more than all'} of the record's {P} periods")
+            raise FileError(f"--skip-periods {skip_periods} {left}; the noise model needs at least 2 "
+                            f"(--skip-periods {max(P - 2, 0)} at most)")
         u_p, y_p = u_p[..., skip_periods:, :], y_p[..., skip_periods:, :]
     if o["detrend"]:
         u_p, y_p = (np.stack([detrended(r) for r in x]) if x.ndim == 3 else detrended(x) for x in (u_p, y_p))
@@ -233,6 +237,21 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         w0 = 2 * np.pi / split.period      # the period given
     return Measurements(u=u_p, y=y_p, w0=w0, format=fmt, fs=fs, trimmed=split.trimmed, skipped=skip_periods,
                         input=raw.names[0], output=raw.names[1], fs_source=source)
+
+
+_INPUT_ONLY = contextvars.ContextVar("lptv_read_input_only", default=False)
+"""True inside :func:`read_input`: the output's place is the input's, not a second channel."""
+
+
+def read_input(path, *, u=None, **options) -> "Measurements":
+    """The input channel alone, read as :func:`read_measurements` reads a record (its ``y`` is
+    its ``u``): a record for a model's prediction (``lptv simulate``) holds no output, and a
+    time column is read this way too. :func:`read_measurements` refuses one channel in both roles."""
+    token = _INPUT_ONLY.set(True)
+    try:
+        return read_measurements(path, u=u, y=u, **options)
+    finally:
+        _INPUT_ONLY.reset(token)
 
 
 def read_options(**kw) -> dict:
@@ -361,6 +380,8 @@ def _read_csv(path, names):
                             "in the header")
         cols[role] = heads.index(name)
     chosen = (heads[cols["u"]], heads[cols["y"]])
+    if not _INPUT_ONLY.get():
+        distinct_channels([("u", chosen[0]), ("y", chosen[1])], [("u", names["u"]), ("y", names["y"])], "column")
     t_name = find(names["time"], heads, "time", "column", shown) if names["time"] else auto_time(heads, chosen)
     if t_name is not None and t_name not in chosen:
         cols["time"] = heads.index(t_name)
@@ -598,6 +619,8 @@ def _wanted(names, available, kind, shown):
     """The file's names of u, y and (if any) the time, and the sampling variables present."""
     u = find(names["u"], available, "u", kind, shown)
     y = find(names["y"], available, "y", kind, shown)
+    if not _INPUT_ONLY.get():
+        distinct_channels([("u", u), ("y", y)], [("u", names["u"]), ("y", names["y"])], kind)
     t = find(names["time"], available, "time", kind, shown) if names["time"] else auto_time(available, (u, y))
     extra = [n for n in FS_NAMES + DT_NAMES + ("w0",) if n in available and n not in (u, y)]
     return u, y, t, extra
