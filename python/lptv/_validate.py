@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import sys
 import os
+import stat
 from typing import Optional
 
 import numpy as np
@@ -176,10 +177,30 @@ def as_path(x, name="path"):
     return p
 
 
+def not_regular(path) -> Optional[str]:
+    """Why ``path`` is not a file to read, if it exists and is not a regular file (a FIFO, a
+    socket, a device, a folder), else None: opening a FIFO with no writer waits for ever, and a
+    device may never end."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return None                    # missing or unreadable: the open's own error says which
+    if stat.S_ISREG(mode):
+        return None
+    kind = ("a folder" if stat.S_ISDIR(mode) else "a FIFO (named pipe)" if stat.S_ISFIFO(mode)
+            else "a socket" if stat.S_ISSOCK(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else "not a regular file")
+    return f"is {kind}, not a regular file"
+
+
 def load_json(path, name="path"):
-    """The JSON document in a file; a file that is not JSON text (binary data, another format) is a
-    ValueError naming the file, and a missing file the usual OSError (FileNotFoundError)."""
+    """The JSON document in a file; a file that is not JSON text (binary data, another format) or
+    not a regular file (a FIFO, a device) is a ValueError naming the file, and a missing file the
+    usual OSError (FileNotFoundError)."""
     p = as_path(path, name)
+    why = not_regular(p)
+    if why:
+        raise ValueError(f"{p}: {why}")
     with open(p, "rb") as f:
         raw = f.read()
     try:

@@ -110,6 +110,28 @@ def test_kept_pool_workers_follow_the_callers_folder(fresh_pool, tmp_path, monke
     assert out.rows[0]["ok"], out.rows[0]["error"]
 
 
+def test_kept_pool_outlives_the_folder_it_was_started_in(fresh_pool, tmp_path, monkeypatch):
+    # a notebook's run folder, deleted after the first study: the workers forked there stand in a
+    # folder that no longer exists, and every later study's chunks were lost (FileNotFoundError)
+    model, ms = small_lptv()
+    first = tmp_path / "run"
+    first.mkdir()
+    monkeypatch.chdir(first)
+    before = lptv.montecarlo(model, ms, executor="processes", workers=2, **SMALL)   # the pool forks here
+    monkeypatch.chdir(tmp_path)
+    first.rmdir()
+    after = lptv.montecarlo(model, ms, executor="processes", workers=2, **SMALL)
+    assert [f["error"] for f in after.fits if not f["ok"]] == []
+    assert_same_study(before, after)
+    # the caller itself standing in a deleted folder: the workers still run (no relative path here)
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    again = lptv.montecarlo(model, ms, executor="processes", workers=2, **SMALL)
+    assert_same_study(before, again)
+
+
 def test_chunk_plan_covers_every_item_once_long_tasks_first():
     for n in (1, 7, 64, 256, 2000):
         for w in (1, 2, 8):

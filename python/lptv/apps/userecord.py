@@ -7,6 +7,7 @@ period, sampling or channel, a unit that differs) is a one-line error with exit 
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 
@@ -57,6 +58,9 @@ def _same_channel(a: str, b: str) -> bool:
 
 def load_model(path):
     """An lptv.Model or lptv.MimoModel from its JSON file (by its format)."""
+    if os.path.exists(path) and not os.path.isfile(path):
+        # a FIFO with no writer would keep the open below waiting for ever
+        raise FileError("is not a regular file (a FIFO, a device or a folder): give the model's JSON file")
     try:
         with open(path, "rb") as f:
             head = json.loads(f.read().decode("utf-8", errors="replace"))

@@ -168,11 +168,26 @@ def _timed_chunk(items: Sequence, fn: Callable, shared: Any, cwd: Optional[str] 
     """:func:`run_chunk` and the seconds it took on the worker; in the folder ``cwd`` if given
     (a kept pool's worker was forked where the caller was then, and relative paths are the
     caller's)."""
-    if cwd is not None and os.getcwd() != cwd:
-        os.chdir(cwd)
+    if cwd is not None:
+        try:
+            here = os.getcwd()
+        except FileNotFoundError:   # the folder the worker was forked in has been deleted since
+            here = None
+        if here != cwd:
+            os.chdir(cwd)
     t0 = time.perf_counter()
     results = run_chunk(items, fn, shared)
     return results, time.perf_counter() - t0
+
+
+def _caller_folder() -> str:
+    """The caller's working folder, for a kept pool's workers to run in; if it was deleted (a
+    temporary folder removed while the process still stands in it), the root: a relative path
+    then names nothing anywhere, and the task's own error says which."""
+    try:
+        return os.getcwd()
+    except FileNotFoundError:
+        return os.path.abspath(os.sep)
 
 
 def _is_dask_client(obj) -> bool:
@@ -406,7 +421,7 @@ def _run_futures(fn, items, todo, shared, executor, workers, chunk_size, bar, we
     else:
         pool = executor
     try:
-        cwd = os.getcwd() if kept else None
+        cwd = _caller_folder() if kept else None
         futures = {pool.submit(_timed_chunk, [items[i] for i in c], fn, shared, cwd): c for c in chunks}
         for fut in cf.as_completed(futures):
             c = futures[fut]

@@ -12,7 +12,7 @@ from typing import Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .._validate import as_float, as_int, as_path, as_positive_float
+from .._validate import as_float, as_int, as_path, as_positive_float, not_regular
 from ..estimation.identify import COVARIANCES, METHODS, NOISES, _counts, _known_list, _rows, identify
 from ..atomic import atomic_open, atomic_path
 from ..records.measurements import Measurements, read_measurements, read_options
@@ -68,6 +68,8 @@ def file_digest(path) -> Optional[str]:
     """The SHA-256 of a file's bytes (None when it cannot be read here: on a cluster whose
     workers alone see it)."""
     h = hashlib.sha256()
+    if not_regular(path):
+        return None                  # a FIFO would hang the read: the task's reader refuses it
     try:
         with open(path, "rb") as f:
             for block in iter(lambda: f.read(1 << 20), b""):

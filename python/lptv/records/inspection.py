@@ -20,7 +20,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from .._validate import _array, as_float, as_int, as_path
+from .._validate import _array, as_float, as_int, as_path, not_regular
 from .channels import FileError
 from .scan import (ALPHA, NOISE_HALF_WINDOW, REPEAT_LIMIT, SIGMAS, WHOLE, LineClass,  # noqa: F401
                          _classify, _detrended, _drift, _output_multiple, _pooled, _residue_at, _spectra,
@@ -401,6 +401,9 @@ def _raw_record(path, u, y, time, fs_given):
         raise FileError("no such file")
     if path.is_dir():
         raise FileError("is a directory, not a measurement file")
+    why = not_regular(path)
+    if why:
+        raise FileError(why)          # a FIFO would hang the read for ever
     if fmt == "CSV":
         raw = _read_csv(path, names)
     elif fmt == "NPZ":

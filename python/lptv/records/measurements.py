@@ -34,7 +34,7 @@ from typing import Callable, Optional, Tuple
 
 import numpy as np
 
-from .._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed
+from .._validate import as_bool, as_float, as_int, as_optional, as_path, looks_transposed, not_regular
 from .check import RecordCheck, RecordWarning, check_record, detrended  # noqa: F401 - lptv.records.measurements.*
 from .channels import (DT_NAMES, FS_NAMES, FileError, auto_time, channel_name, distinct_channels, find,
                        fs_from_time, listing, read_several, several_channels, stored_fs, time_unit)
@@ -184,6 +184,9 @@ def read_measurements(path, periods: Optional[int] = None, *, fs: Optional[float
         raise FileError("no such file")
     if path.is_dir():
         raise FileError("is a directory, not a measurement file")
+    why = not_regular(path)
+    if why:
+        raise FileError(why)          # a FIFO would hang the read for ever
     fs = _sampling(fs, dt)
     if fmt == "CSV":
         raw = _read_csv(path, names)
