@@ -53,3 +53,48 @@ def test_a_fifo_is_one_line_and_exit_2_on_the_command_line(tmp_path, args):
     assert p.returncode == 2, (p.returncode, p.stderr)
     lines = p.stderr.strip().splitlines()
     assert len(lines) == 1 and "not a regular file" in lines[0] and "Traceback" not in p.stderr, p.stderr
+
+
+# ------------------------------------------------------------------------------ model descriptions
+
+def _description():
+    m = lptv.Model([[2.0], [1.0]], [[1.0]], w0=1.0)
+    d = m.to_dict()
+    d["eta_names"], d["covariance"] = ["a0.re0", "b0.re0"], [[1.0, 0.1], [0.1, 2.0]]
+    return d
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("a_real", [[True], [1.0]], r"a_real\[0\]\[0\] holds true, not a number"),
+    ("b_real", [[False]], r"b_real\[0\]\[0\] holds false"),
+    ("covariance", [[-1.0, 0.1], [0.1, 2.0]], r"covariance has the negative variance -1 .*a0.re0"),
+    ("covariance", [[1.0, 0.1], [0.2, 2.0]], r"covariance is not symmetric"),
+    ("covariance", [[1.0, True], [0.1, 2.0]], r"covariance\[0\]\[1\] holds true"),
+])
+def test_a_description_that_is_not_a_model_is_refused_with_its_key(key, value, message):
+    d = _description()
+    lptv.Model.from_dict(d)                      # the description itself reads
+    d[key] = value
+    with pytest.raises(ValueError, match=message):
+        lptv.Model.from_dict(d)
+
+
+def test_a_leading_coefficient_that_vanishes_within_the_period_is_refused(tmp_path):
+    m = lptv.Model([[0, 1.0, 0], [0.5, 0, 0.5]], [[0, 1.0, 0]], w0=1.0)      # a_1(t) = cos t
+    m.save(tmp_path / "m.json")
+    with pytest.raises(ValueError, match=r"a_1\(t\) vanishes near t = 1.5708 s"):
+        lptv.Model.load(tmp_path / "m.json")
+
+
+def test_the_stability_of_a_large_lti_model_of_several_channels_is_one_eigenproblem():
+    from lptv.model.floquet import stability_check
+
+    n, rng = 60, np.random.default_rng(0)
+    a = np.zeros((4, n, n, 1))
+    for k, c in enumerate([6.0, 11.0, 6.0, 1.0]):          # (s + 1)(s + 2)(s + 3) on each channel
+        a[k] = c * np.eye(n)[..., None]
+    b = rng.standard_normal((1, n, n, 1))
+    assert stability_check(lptv.MimoModel(a, b, w0=1.0)) == (None, None)
+    a[0] -= 12.0 * np.eye(n)[..., None]                     # a0 = -6: a root in the right half plane
+    unstable, undecided = stability_check(lptv.MimoModel(a, b, w0=1.0))
+    assert undecided is None and "root of det A(s)" in unstable

@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import _core
 from .._validate import _array, as_path, as_real_1d, check_finite, load_json
-from .siso import Model, _short, _ts, _w0
+from .siso import Model, _no_bool, _short, _ts, _w0
 
 FORMAT_VERSION = 1
 """The version of the JSON description :meth:`MimoModel.to_dict` writes and :meth:`MimoModel.from_dict` reads."""
@@ -257,6 +257,7 @@ class MimoModel:
         ts = _ts(d.get("ts"))
 
         def coef(key, shape_mid):
+            _no_bool(d[key], f"{what}: {key}")
             try:
                 arr = np.array(d[key], dtype=float)
             except (TypeError, ValueError):

@@ -321,6 +321,7 @@ class Model:
         ts = _ts(d.get("ts"))
 
         def coef(key):
+            _no_bool(d[key], f"lptv.Model description: {key}")
             try:
                 arr = np.array(d[key], dtype=float)
             except (TypeError, ValueError):
@@ -341,12 +342,17 @@ class Model:
             m = cls(parts["a_real"] + 1j * parts["a_imag"], parts["b_real"] + 1j * parts["b_imag"], w0=w0, ts=ts)
         except ValueError as e:
             raise ValueError(f"lptv.Model description: {e}") from None
+        try:
+            check_leading(m)
+        except ValueError as e:
+            raise ValueError(f"lptv.Model description: a_real, a_imag: {e}") from None
         cov = d.get("covariance")
         if cov is not None:
             names = d.get("eta_names", ())
             if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
                 raise ValueError(f"lptv.Model description: eta_names must be a list of parameter names, "
                                  f"got {_short(names)}")
+            _no_bool(cov, "lptv.Model description: covariance")
             try:
                 cov = np.array(cov, dtype=float)
             except (TypeError, ValueError):
@@ -357,6 +363,7 @@ class Model:
                                  f"its {len(names)} eta_names")
             if not np.all(np.isfinite(cov)):
                 raise ValueError("lptv.Model description: covariance contains NaN or inf")
+            check_covariance(cov, names)
             m.covariance, m.eta_names = cov, tuple(names)
         if "context" in d:
             from ..use.modelfile import check_context
@@ -400,6 +407,73 @@ class Model:
         dom = "continuous" if not self.discrete else f"discrete, ts={self.ts:g}"
         return (f"lptv.Model(na={self.na}, nb={self.nb}, ka={self.ka}, kb={self.kb}, "
                 f"w0={self.w0:g}, {dom})")
+
+
+def _no_bool(x, where):
+    """Refuse true/false anywhere in a nested list of a description's numbers: NumPy would read
+    them as 1 and 0 without a word."""
+    stack = [(x, "")]
+    while stack:
+        v, at = stack.pop()
+        if isinstance(v, bool):
+            raise ValueError(f"{where}{at} holds {str(v).lower()}, not a number")
+        if isinstance(v, (list, tuple)):
+            stack.extend(reversed([(e, f"{at}[{i}]") for i, e in enumerate(v)]))   # the first one first
+
+
+# A symmetric covariance's entries agree to the last bits; its diagonal (the variances) is >= 0.
+_SYMMETRY_RTOL = 1e-9
+
+
+def check_covariance(cov: np.ndarray, names) -> None:
+    """A saved covariance must be a covariance: no negative variance, symmetric up to rounding."""
+    diag = np.diag(cov)
+    if np.any(diag < 0):
+        i = int(np.argmax(diag < 0))
+        raise ValueError(f"lptv.Model description: covariance has the negative variance {diag[i]:.6g} on its "
+                         f"diagonal (entry {i}, {names[i]}): not a covariance")
+    scale = float(np.max(np.abs(cov))) if cov.size else 0.0
+    gap = np.abs(cov - cov.T)
+    if cov.size and float(gap.max()) > _SYMMETRY_RTOL * scale:
+        i, j = np.unravel_index(int(np.argmax(gap)), gap.shape)
+        raise ValueError(f"lptv.Model description: covariance is not symmetric: entry [{i}][{j}] = "
+                         f"{cov[i, j]:.6g} but [{j}][{i}] = {cov[j, i]:.6g}")
+
+
+def check_leading(model) -> None:
+    """The leading coefficient a_na(t) must not vanish within the period: the equation cannot be
+    solved for the highest derivative (the highest shift) where it does. Continuous time: on a grid
+    of 256 points per harmonic (a_na(t) is a trigonometric polynomial of degree Ka), a sign change
+    of its real part with a small imaginary part, or a value below 1e-12 of its largest; discrete
+    time: at each of the N samples, a value below 1e-14 of the largest (the thresholds of the
+    core's monodromy)."""
+    na = model.na
+    if model.discrete:
+        N = model.samples_per_period
+        t = np.arange(N) * model.ts
+        v = model.a_at(t)[:, na]
+        vmax = np.max(np.abs(v))
+        bad = np.flatnonzero(np.abs(v) <= 1e-14 * vmax)
+        if bad.size:
+            raise ValueError(f"the leading coefficient a_{na}[k] vanishes at sample k = {bad[0]} of the period; "
+                             f"the recursion cannot be solved for y[k + {na}] there")
+        return
+    n = 256 * (model.ka + 1) + 1
+    t = np.linspace(0.0, model.period, n)
+    v = model.a_at(t)[:, na]
+    vmax = np.max(np.abs(v))
+    small = np.abs(v) <= 1e-12 * vmax
+    re = v.real
+    flips = (np.signbit(re[1:]) != np.signbit(re[:-1])) & (np.abs(v.imag[1:]) <= 1e-6 * vmax)
+    if small.any() or flips.any():
+        i = int(np.argmax(small)) if small.any() else None
+        k = int(np.argmax(flips)) if flips.any() else None
+        if i is None or (k is not None and k < i):
+            tz = t[k] + (t[k + 1] - t[k]) * re[k] / (re[k] - re[k + 1])
+        else:
+            tz = t[i]
+        raise ValueError(f"the leading coefficient a_{na}(t) vanishes near t = {tz:.6g} s (period "
+                         f"{model.period:.6g} s): the equation cannot be solved for the highest derivative there")
 
 
 def _short(x) -> str:
