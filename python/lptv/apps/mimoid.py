@@ -37,6 +37,7 @@ from lptv import NumericalError
 from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, count, fundamental, in_option_terms, integer,
                                output_folder, parse_counts, parse_lines, positive, read_options)
 from lptv.apps import inspectrec, units
+from lptv.apps.mimoreport import physical_table
 from lptv.apps.report import write_fit
 from lptv.apps.stability import stability_summary, stability_text
 from lptv.records.measurements import FileError, read_measurements
@@ -259,19 +260,10 @@ def text_summary(res, u_units=(), y_units=()) -> str:
     return res.summary(units=units.mimo_coefficient_units(res.model, u_units, y_units))
 
 
-def _physical_table(physical, u_units, y_units):
-    """The rows of :meth:`lptv.MimoIdentificationResult.parameters` of the scaled parameters."""
-    from lptv.judgement.mimo_result import parameter_rows
-
-    name = physical.scale[0]
-    fixed = frozenset(n for n in physical.eta_names if n.startswith(f"{name}[") and n.endswith(".re0"))
-    return parameter_rows(physical.eta_names, physical.eta, physical.covariance, 0.95, fixed)
-
-
 def physical_rows(physical, u_units, y_units) -> list:
     """summary.json's ``parameters_scaled``: the rows of the scaled parameters with their unit."""
     unit_of = units.mimo_coefficient_units(physical.model, u_units, y_units, physical.scale)
-    rows = _physical_table(physical, u_units, y_units)
+    rows = physical_table(physical, u_units, y_units)
     for r in rows:
         r["unit"] = unit_of.get(r["name"].split(".")[0], "")
         if r["kind"] == "normalised":
@@ -286,7 +278,7 @@ def physical_text(physical, u_units, y_units) -> str:
     name, value = physical.scale
     unit_of = units.mimo_coefficient_units(physical.model, u_units, y_units, physical.scale)
     return (f"parameters in physical form (--scale {name}={value:g}: the mean of {name} is {value:g} times the "
-            "identity):\n" + format_table(_physical_table(physical, u_units, y_units), 0.95, unit_of)
+            "identity):\n" + format_table(physical_table(physical, u_units, y_units), 0.95, unit_of)
             .replace("(normalised)", "(by --scale)"))
 
 

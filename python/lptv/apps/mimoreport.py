@@ -10,6 +10,15 @@ import numpy as np
 from lptv.apps.report import Report
 
 
+def physical_table(physical, u_units, y_units):
+    """The rows of :meth:`lptv.MimoIdentificationResult.parameters` of the scaled parameters."""
+    from lptv.judgement.mimo_result import parameter_rows
+
+    name = physical.scale[0]
+    fixed = frozenset(n for n in physical.eta_names if n.startswith(f"{name}[") and n.endswith(".re0"))
+    return parameter_rows(physical.eta_names, physical.eta, physical.covariance, 0.95, fixed)
+
+
 def normalised_residues(res) -> np.ndarray:
     """|e_{l,p}|^2 / C_{e,l}[p, p] per row and output, shape (rows, ny): each output's normalised
     residue, F(2, 2(P-1))-distributed for a right model with noise (co)variances from P periods
@@ -69,14 +78,12 @@ def build(res, *, files, inputs, outputs, w0, stability, physical=None, experime
     rep.table(["parameter", "estimate", "std", "95 % interval", "unit"],
               _parameter_rows(res.parameters(0.95), units.mimo_coefficient_units(model, u_units, y_units)))
     if physical is not None:
-        from lptv.apps.mimoid import _physical_table
-
         name, value = physical.scale
         rep.paragraph(f"In physical form (--scale {name}={value:g}): the equation multiplied from the left so that "
                       f"the mean of {name} is {value:g} times the identity (the same system; the covariance carried "
                       "by the exact Jacobian of that map).")
         rep.table(["parameter", "value", "std", "95 % interval", "unit"],
-                  _parameter_rows(_physical_table(physical, u_units, y_units),
+                  _parameter_rows(physical_table(physical, u_units, y_units),
                                   units.mimo_coefficient_units(physical.model, u_units, y_units, physical.scale),
                                   fixed="(by --scale)"))
 
