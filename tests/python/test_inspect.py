@@ -142,6 +142,43 @@ def test_a_dead_input_is_refused_as_dead():
         lptv.inspect(u=np.full(1000, 0.3), y=np.random.default_rng(0).standard_normal(1000), fs=10.0)
 
 
+@pytest.mark.parametrize("scale", [1e-140, 1e-60, 1e60, 1e140])
+def test_the_findings_do_not_depend_on_the_record_s_units(records, scale):
+    """The same record in units 1e+-60 or 1e+-140 times larger: the same period, lines and
+    transient, the spectra and noise in the record's own units (to rounding)."""
+    T, fs, P, noise, lines = CASES["odd-3"]
+    t, f, x = records["odd-3"]
+    one = lptv.inspect(u=f, y=x, fs=fs)
+    r = lptv.inspect(u=f * scale, y=x * (scale / 7.0), fs=fs)
+    assert (r.period_samples, r.periods, r.transient_periods) == (one.period_samples, one.periods, one.transient_periods)
+    np.testing.assert_array_equal(r.lines, one.lines)
+    np.testing.assert_allclose(r.U / scale, one.U, rtol=1e-12, atol=1e-15 * np.abs(one.U).max())
+    np.testing.assert_allclose(r.noise_y / (scale / 7.0) ** 2, one.noise_y, rtol=1e-10)
+    assert r.command == one.command
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e200, 1e300])
+def test_a_record_whose_squares_leave_double_precision_is_refused_with_the_reason(records, scale):
+    T, fs, P, noise, lines = CASES["odd-3"]
+    t, f, x = records["odd-3"]
+    with pytest.raises(ValueError, match=r"u reaches .*squares of its values.*rescale the record"):
+        lptv.inspect(u=f * scale, y=x, fs=fs)
+    with pytest.raises(ValueError, match=r"y reaches .*rescale the record"):
+        lptv.inspect(u=f, y=x * scale, fs=fs)
+
+
+@pytest.mark.parametrize("fs", [1e-320, 1e-150, 1e150, 1e300])
+def test_a_sampling_frequency_beyond_any_units_is_refused(records, fs, tmp_path, capsys):
+    t, f, x = records["odd-3"]
+    with pytest.raises(ValueError, match=r"fs: a sampling frequency of .* Hz is outside"):
+        lptv.inspect(u=f, y=x, fs=fs)
+    with np.errstate(over="ignore"):
+        dt = 1.0 / fs
+    with pytest.raises(ValueError, match=r"dt: a sampling frequency of .* Hz is outside" if np.isfinite(dt)
+                       else "dt must be a finite real number"):
+        lptv.inspect(u=f, y=x, dt=dt)
+
+
 # ------------------------------------------------------------------------------ the commands
 
 def test_lptv_inspect_prints_the_findings_and_writes_a_report(rig, tmp_path, capsys):

@@ -487,6 +487,10 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
         fs_in = as_float(fs, "fs", minimum=0.0, open_min=True)
     elif dt is not None:
         fs_in = 1.0 / as_float(dt, "dt", minimum=0.0, open_min=True)
+    if fs_in is not None and not FS_RANGE[0] <= fs_in <= FS_RANGE[1]:
+        raise ValueError(f"{'fs' if fs is not None else 'dt'}: a sampling frequency of {fs_in:g} Hz is outside "
+                         f"{FS_RANGE[0]:g} .. {FS_RANGE[1]:g} Hz, where the periods' times and frequencies (w0 = "
+                         "2 pi fs / N) would lose their precision or overflow: give it in other units")
     if reach is not None:
         reach = as_int(reach, "reach", minimum=1, maximum=10**6)
     if path is not None:
@@ -545,6 +549,10 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
     file_fs, file_src = found if found is not None else (None, None)
     fs_used, fs_src = (fs_in, None) if fs_in is not None else (file_fs, file_src)
     n = uu.size
+    # scale-free: each channel by a power of two (exact) to a largest value between 1/2 and 1,
+    # the reported spectra and noise in the record's own units again at the end
+    (uu, su), (yy, sy) = (_unit(v, name) for v, name in zip((uu, yy), names))
+    rr = uu if ref_name is None else _unit(rr, f"the reference '{ref_name}'")[0]
     L, Lf, r = find_period(rr)
     lags = np.arange(r.size)
     notes = []
@@ -582,9 +590,9 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
                      "store it as one long record (or as periods of the right length)")
     us, ys = uu[left:].reshape(P, N), yy[left:].reshape(P, N)
     drifts = [_drift(xs) for xs in (us, ys)]
-    for name, drift in zip(names, drifts):
+    for name, drift, scale in zip(names, drifts, (su, sy)):
         if drift is not None:
-            notes.append(f"'{name}' drifts by {drift[0]:.3g} per period ({drift[1]:.0f} standard errors): a trend the "
+            notes.append(f"'{name}' drifts by {drift[0] / scale:.3g} per period ({drift[1]:.0f} standard errors): a trend the "
                          "periods do not share; take it out (--detrend), or the spectra's lowest lines carry it "
                          "(it is taken out here)")
     if drifts[0] is not None:
@@ -640,5 +648,26 @@ def inspect(path=None, *, u=None, y=None, time=None, fs: Optional[float] = None,
                       output_repeat_ratio=float(r_y), periods=P, leftover=left, transient_ratios=ratios,
                       transient_limit=float(limit), transient_periods=skip, transient=tr, lines=excited, spacing=s,
                       weak_input_lines=weak, input_snr_db=snr_u, output_snr_db=snr_y, reach=K, classes=classes,
-                      time_variation_reach=k_tv, threshold=t, spectrum_lines=lines, U=U, Y=Y,
-                      noise_u=nu / Ps, noise_y=ny / Ps, notes=tuple(notes))
+                      time_variation_reach=k_tv, threshold=t, spectrum_lines=lines, U=U / su, Y=Y / sy,
+                      noise_u=nu / Ps / su ** 2, noise_y=ny / Ps / sy ** 2, notes=tuple(notes))
+
+
+FS_RANGE = (1e-100, 1e100)
+"""The sampling frequencies (Hz) :func:`inspect` takes."""
+AMPLITUDE_RANGE = (1e-150, 1e150)
+"""The largest |value| of a channel :func:`inspect` takes: its squares (the noise's variances)
+stay within double precision's range."""
+
+
+def _unit(x, name):
+    """(x scaled by a power of two to a largest |value| in [1/2, 1), the scale); FileError for a
+    channel whose largest |value| is outside AMPLITUDE_RANGE (0 is left as it is)."""
+    top = float(np.max(np.abs(x)))
+    if top == 0.0:
+        return x, 1.0
+    if not AMPLITUDE_RANGE[0] <= top <= AMPLITUDE_RANGE[1]:
+        raise FileError(f"{name} reaches |{top:.3g}|: outside {AMPLITUDE_RANGE[0]:g} .. {AMPLITUDE_RANGE[1]:g}, where "
+                        "the squares of its values (the noise's variances) leave double precision's range: "
+                        "rescale the record (give it in other units)")
+    scale = math.ldexp(1.0, -math.frexp(top)[1])
+    return x * scale, scale
