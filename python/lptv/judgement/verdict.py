@@ -86,6 +86,11 @@ class ResidueTests:
     """Per row of the fit: 1 - E|e_l|^2 / var e_l after the fit (its share of the parameters),
     with the fit's projection taken over the judged rows (NaN for the others)."""
     alpha: float = ALPHA
+    signal_off_excited: bool = True
+    """Whether the output stands above its noise on some line between the excited ones, near
+    the fitted rows (F(2, 2(P-1)) at 1 % over those lines): time variation (or distortion) that
+    a harmonic could model; without it the harmonic score tests answer a misfit on the excited
+    lines alone."""
 
     @property
     def rejected(self) -> Tuple[ResidueTest, ...]:
@@ -109,7 +114,19 @@ class ResidueTests:
             out.append(f"the normalised residues on the {t.rows.size} {t.name} are {side} "
                        f"(z = {t.statistic:.2f}, p = {t.p_value:.2g}, Holm-adjusted {t.p_holm:.2g} "
                        f"< {self.alpha:g}){why}")
+        if self.orders_first:
+            out.append("but the output shows no signal between the excited lines (no sign of time variation): "
+                       "the harmonic score tests then answer a misfit on the excited lines, such as an order too "
+                       "low (na or nb); try one order more first (lptv select compares them)")
         return tuple(out)
+
+    @property
+    def orders_first(self) -> bool:
+        """Whether a harmonic score test rejects while the output shows nothing between the
+        excited lines (:attr:`signal_off_excited` False): a misfit of the orders moves every
+        efficient score (the projection on the fitted parameters carries it into each harmonic's),
+        so the harmonic's advice would point to a time variation the record does not show."""
+        return not self.signal_off_excited and any(t.rejects and t.kind == "score" for t in self.tests)
 
 
 def _signal_lines(d, P: int) -> np.ndarray:
@@ -158,6 +175,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     theta = np.asarray(res.theta)
     # Per experiment: its rows in sorted order, S (interleaved), the real Jacobian.
     order, S_blocks, J_blocks, nus, signal_rows, offsets = [], [], [], [], [], []
+    off_signal = False   # the output above its noise between the excited lines, in some experiment
     wfit = []     # per experiment: the variances the fit weighed its rows by (interleaved)
     err_blocks = []   # per experiment: covariance of the rows' relative variance errors
     extensions = _extensions(structure, par)
@@ -223,6 +241,7 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
             nus.append(np.full(srt.size, 2.0 * (P - 1) if P >= 2 else np.inf))
         signal_rows.append(np.ones(srt.size, bool))
         ex = np.asarray(excited[e] if excited is not None else _core.excited_lines(d._cpp, 100.0), int)
+        off_signal = off_signal or _output_between(d_fit, P, srt, ex, K)
         offsets.append(_offset_groups(srt, ex))
         offsets[-1][srt <= K] = -1     # rows that read DC or a conjugate line: in "rows with signal" only
         sdiag = np.diag(S_blocks[-1]).copy()
@@ -328,7 +347,27 @@ def residue_tests(res, structure, excited: Optional[Sequence[np.ndarray]] = None
     score_all[order] = np.where(judged, score, np.nan)
     lev_all = np.full(lines.size, np.nan)
     lev_all[order] = 1.0 - shrink
-    return ResidueTests(tests=out_tests, judged=judged_all, score=score_all, leverage=lev_all)
+    return ResidueTests(tests=out_tests, judged=judged_all, score=score_all, leverage=lev_all,
+                        signal_off_excited=bool(off_signal))
+
+
+def _output_between(d, P: int, rows, excited, K: int) -> bool:
+    """Whether the output stands above its noise on a line that is not excited, within the
+    fitted rows' reach (rows - K .. rows + K, lines 1 .. max_line - 1): |Y_l|^2 / varY_l beyond
+    F(2, 2(P-1))'s point at 1 % over those lines (Bonferroni). True when it cannot be told
+    (P < 2, no such line, no excited line known)."""
+    from .. import _dist as stats_
+
+    if P < 2 or excited.size == 0 or rows.size == 0:
+        return True
+    lo, hi = max(int(rows.min()) - K, 1), min(int(rows.max()) + K, d.max_line - 1)
+    cand = np.setdiff1d(np.arange(lo, hi + 1), excited)
+    if cand.size == 0:
+        return True
+    Y, v = np.abs(np.asarray(d.Y)[cand]) ** 2, np.asarray(d.varY)[cand]
+    if not np.all(v > 0):
+        return True
+    return bool(np.any(Y / v > stats_.f_isf(0.01 / cand.size, 2, 2 * (P - 1))))
 
 
 def _extensions(structure, par) -> dict:
