@@ -284,6 +284,8 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         Ce = np.einsum("pi,rij,qj->rpq", lead, Ce, lead)
     a, b = st.coefficients(xi)
     model = MimoModel(a, b, w0=d0.w0, ts=d0.ts)
+    if cov is not None:
+        model.covariance, model.eta_names = cov, tuple(st.names)
     if mos is None:
         row_P = np.concatenate([np.full(r.size, p) for r, p in zip(rows_list, P)])
         Cv = Ce

@@ -9,12 +9,12 @@ import numpy as np
 
 from .. import _core
 from .._validate import _array, as_path, as_real_1d, check_finite, load_json
-from .siso import Model, _no_bool, _short, _ts, _w0
+from .siso import Model, _no_bool, _short, _ts, _w0, read_covariance
 
 FORMAT_VERSION = 1
 """The version of the JSON description :meth:`MimoModel.to_dict` writes and :meth:`MimoModel.from_dict` reads."""
 _FIELDS = ("format", "version", "n_outputs", "n_inputs", "w0", "ts", "a_real", "a_imag", "b_real", "b_imag",
-           "context")
+           "eta_names", "covariance", "context")
 
 
 def _as_coefficients(x, name, rows=None):
@@ -210,6 +210,11 @@ class MimoModel:
 
     context = None
     """What the model was fitted to, as :attr:`lptv.Model.context` (:mod:`lptv.use.modelfile`)."""
+    covariance = None
+    """Covariance of the estimated real parameters (``eta_names``, as
+    :attr:`lptv.MimoIdentificationResult.parameter_names`), set by :func:`lptv.identify` and kept
+    by :meth:`save` (``lptv.validate`` then counts the model's own estimation error)."""
+    eta_names = ()
 
     # -- persistence -------------------------------------------------------------
     def to_dict(self) -> dict:
@@ -225,6 +230,9 @@ class MimoModel:
             "b_real": self.b.real.tolist(),
             "b_imag": self.b.imag.tolist(),
         }
+        if self.covariance is not None:
+            d["eta_names"] = list(self.eta_names)
+            d["covariance"] = np.asarray(self.covariance).tolist()
         if self.context is not None:
             d["context"] = dict(self.context)
         return d
@@ -275,6 +283,13 @@ class MimoModel:
                                  f"{parts[f'{side}_real'].shape}, got {parts[f'{side}_imag'].shape}")
         try:
             m = cls(parts["a_real"] + 1j * parts["a_imag"], parts["b_real"] + 1j * parts["b_imag"], w0=w0, ts=ts)
+            if d.get("covariance") is not None:
+                names, cov = read_covariance(d, what)
+                bad = [n for n in names if not _mimo_name(n, m)]
+                if bad:
+                    raise ValueError(f"{what}: eta_names: {bad[0]!r} is not a coefficient entry of this model "
+                                     "(names like 'a0[0,1].re1')")
+                m.eta_names, m.covariance = names, cov
             if "context" in d:
                 from ..use.modelfile import check_context
 
@@ -284,7 +299,8 @@ class MimoModel:
         return m
 
     def save(self, path) -> None:
-        """Write the model as JSON (readable by :meth:`MimoModel.load`)."""
+        """Write the model as JSON (readable by :meth:`MimoModel.load`), with its covariance
+        when it has one."""
         from ..atomic import atomic_open
 
         with atomic_open(as_path(path)) as f:
@@ -309,3 +325,16 @@ class MimoModel:
         dom = "continuous" if not self.discrete else f"discrete, ts={self.ts:g}"
         return (f"lptv.MimoModel(n_outputs={self.n_outputs}, n_inputs={self.n_inputs}, na={self.na}, "
                 f"nb={self.nb}, ka={self.ka}, kb={self.kb}, w0={self.w0:g}, {dom})")
+
+
+def _mimo_name(name: str, m: "MimoModel") -> bool:
+    """Whether ``name`` ('a0[0,1].re1') names a coefficient entry's harmonic of ``m``."""
+    import re
+
+    hit = re.fullmatch(r"([ab])(\d+)\[(\d+),(\d+)\]\.(re|im)(\d+)", name)
+    if hit is None:
+        return False
+    side, n, p, q, part, k = hit.groups()
+    n, p, q, k = int(n), int(p), int(q), int(k)
+    order, cols, K = (m.na, m.n_outputs, m.ka) if side == "a" else (m.nb, m.n_inputs, m.kb)
+    return n <= order and p < m.n_outputs and q < cols and k <= K and not (part == "im" and k == 0)

@@ -346,25 +346,8 @@ class Model:
             check_leading(m)
         except ValueError as e:
             raise ValueError(f"lptv.Model description: a_real, a_imag: {e}") from None
-        cov = d.get("covariance")
-        if cov is not None:
-            names = d.get("eta_names", ())
-            if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
-                raise ValueError(f"lptv.Model description: eta_names must be a list of parameter names, "
-                                 f"got {_short(names)}")
-            _no_bool(cov, "lptv.Model description: covariance")
-            try:
-                cov = np.array(cov, dtype=float)
-            except (TypeError, ValueError):
-                raise ValueError(f"lptv.Model description: covariance must be a square list of numbers, "
-                                 f"got {_short(cov)}") from None
-            if cov.shape != (len(names), len(names)):
-                raise ValueError(f"lptv.Model description: covariance of shape {cov.shape} does not match "
-                                 f"its {len(names)} eta_names")
-            if not np.all(np.isfinite(cov)):
-                raise ValueError("lptv.Model description: covariance contains NaN or inf")
-            check_covariance(cov, names)
-            m.covariance, m.eta_names = cov, tuple(names)
+        if d.get("covariance") is not None:
+            m.eta_names, m.covariance = read_covariance(d, "lptv.Model description")
         if "context" in d:
             from ..use.modelfile import check_context
 
@@ -425,18 +408,37 @@ def _no_bool(x, where):
 _SYMMETRY_RTOL = 1e-9
 
 
-def check_covariance(cov: np.ndarray, names) -> None:
+def read_covariance(d: dict, what: str):
+    """(eta_names, covariance) of a description's ``eta_names`` and ``covariance`` keys, each
+    checked: a list of names, a square finite matrix of their size, a covariance."""
+    cov, names = d.get("covariance"), d.get("eta_names", ())
+    if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
+        raise ValueError(f"{what}: eta_names must be a list of parameter names, got {_short(names)}")
+    _no_bool(cov, f"{what}: covariance")
+    try:
+        cov = np.array(cov, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: covariance must be a square list of numbers, got {_short(cov)}") from None
+    if cov.shape != (len(names), len(names)):
+        raise ValueError(f"{what}: covariance of shape {cov.shape} does not match its {len(names)} eta_names")
+    if not np.all(np.isfinite(cov)):
+        raise ValueError(f"{what}: covariance contains NaN or inf")
+    check_covariance(cov, names, what)
+    return tuple(names), cov
+
+
+def check_covariance(cov: np.ndarray, names, what: str = "lptv.Model description") -> None:
     """A saved covariance must be a covariance: no negative variance, symmetric up to rounding."""
     diag = np.diag(cov)
     if np.any(diag < 0):
         i = int(np.argmax(diag < 0))
-        raise ValueError(f"lptv.Model description: covariance has the negative variance {diag[i]:.6g} on its "
+        raise ValueError(f"{what}: covariance has the negative variance {diag[i]:.6g} on its "
                          f"diagonal (entry {i}, {names[i]}): not a covariance")
     scale = float(np.max(np.abs(cov))) if cov.size else 0.0
     gap = np.abs(cov - cov.T)
     if cov.size and float(gap.max()) > _SYMMETRY_RTOL * scale:
         i, j = np.unravel_index(int(np.argmax(gap)), gap.shape)
-        raise ValueError(f"lptv.Model description: covariance is not symmetric: entry [{i}][{j}] = "
+        raise ValueError(f"{what}: covariance is not symmetric: entry [{i}][{j}] = "
                          f"{cov[i, j]:.6g} but [{j}][{i}] = {cov[j, i]:.6g}")
 
 
