@@ -44,3 +44,26 @@ def test_a_closed_loop_record_with_disturbances_keeps_the_true_structure():
     assert free.sum() == 20
     z = (res.eta - rig.truth())[free] / res.parameter_std[free]
     assert np.max(np.abs(z)) < 4, z
+
+
+def test_on_the_record_s_noise_the_default_moderates_from_eight_periods():
+    """A response that does not repeat (a random walk on both outputs) makes the line test take
+    the record's statistics; at P = 4 the default keeps their sample (co)variances (moderated,
+    the rig's intervals covered 84-91 %), at P = 8 it may moderate them."""
+    rng = np.random.default_rng(5)
+    N = 64
+    for P in (4, 8):
+        t = np.arange(P * N)
+        ph = rng.uniform(0, 2 * np.pi, (2, 20))
+        u = np.stack([np.cos(2 * np.pi * np.outer(t, np.arange(1, 21)) / N + ph[i]).sum(1) for i in range(2)], -1)
+        y = u @ np.array([[0.5, 0.2], [-0.1, 0.8]]) + 0.02 * np.cumsum(rng.standard_normal((P * N, 2)), axis=0)
+        u = u + 0.01 * rng.standard_normal(u.shape)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = lptv.identify(u.reshape(P, N, 2), y.reshape(P, N, 2), na=0, nb=0, w0=1.0)
+        assert res.noise.startswith("full") and "correlated" in res.noise_choice, res.noise_choice
+        if P == 4:
+            assert res.noise == "full", res.noise_choice
+            assert "on the record's noise the moderated route needs 8" in res.noise_choice
+        else:
+            assert "needs 8" not in res.noise_choice
