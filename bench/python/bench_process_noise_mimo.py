@@ -14,6 +14,7 @@ standardised errors, and for 'auto' how often it took the record's statistics an
 moderated them.
 
     python bench/python/bench_process_noise_mimo.py --runs 400 --periods 8 4 16 --loop open feedback
+    python bench/python/bench_process_noise_mimo.py --rows --runs 100 --periods 8 --loop feedback --process 0 5
 """
 from __future__ import annotations
 
@@ -64,6 +65,49 @@ def cell(loop, P, process, runs, methods, seed0):
     return out
 
 
+def rows(args) -> int:
+    """The residues at the true parameters on the record's statistics (noise='full'), per cell:
+    their Monte Carlo mean square over the residue covariance eq. 19.12, and the correlation
+    between the rows of one output and experiment, |E{e_l conj(e_l')}| normalised, by the lag
+    between the rows (independent residues: about 0.9 / sqrt(R))."""
+    from lptv.estimation.mimo_fit import core_data, core_structure, residues
+    from lptv.spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts
+
+    st = MimoStructure(2, 0, as_entry_counts(pr.STRUCTURE["ka"], 2, 2, 2, "ka"), as_entry_counts(0, 0, 2, 2, "kb"),
+                       2, 2, pr.W0)
+    lines, xi = pr.fit_lines(), pr.truth()
+    n = lines.size
+    print(f"# rows at the truth, record's statistics, {args.runs} records a cell (independent |corr| about "
+          f"{0.89 / np.sqrt(args.runs):.2f})")
+    print("loop      P  dist  out exp   E|e|^2 / C_e [min median max]   |corr| at row lag 1 2 5 10   rows 2-7")
+    for P in args.periods:
+        for loop in args.loop:
+            for proc in args.process:
+                E, C = [], []
+                for start in range(0, args.runs, 25):
+                    seeds = [args.seed + 2000 + i for i in range(start, min(args.runs, start + 25))]
+                    for rec in pr.records(seeds, periods=P, loop=loop, process=proc):
+                        ds = [MimoFrequencyData.from_periods(u, y, w0=pr.W0, statistics="record")
+                              for u, y in rec["experiments"]]
+                        res, Ce = residues(core_data(ds, [lines, lines]), core_structure(st), xi)
+                        E.append(res)
+                        C.append(np.real(np.diagonal(Ce, axis1=1, axis2=2)))
+                E, C = np.array(E), np.array(C)
+                ratio = np.mean(np.abs(E) ** 2, axis=0) / C.mean(axis=0)
+                for o in range(2):
+                    for e in range(2):
+                        Z = E[:, e * n:(e + 1) * n, o]
+                        G = Z.T @ Z.conj() / len(Z)
+                        d = np.sqrt(np.real(np.diag(G)))
+                        Cn = np.abs(G) / np.outer(d, d)
+                        r = ratio[e * n:(e + 1) * n, o]
+                        low = Cn[:6, :6][~np.eye(6, dtype=bool)].mean()
+                        print(f"{loop:9s} {P:2d} {proc:5.1f}   {o}   {e}    {r.min():5.2f} {np.median(r):5.2f} {r.max():5.2f}"
+                              f"        " + " ".join(f"{np.diag(Cn, k).mean():4.2f}" for k in (1, 2, 5, 10))
+                              + f"        {low:4.2f}", flush=True)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=200)
@@ -73,7 +117,12 @@ def main(argv=None) -> int:
                     help="each disturbance's rms in N (0: sensor noise alone)")
     ap.add_argument("--methods", nargs="+", default=["wgtls"], choices=["wgtls", "sml"])
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--rows", action="store_true",
+                    help="only the residues at the true parameters (seeds from 2000 + seed): their variance "
+                         "against eq. 19.12 on the record's statistics and their correlation between rows")
     args = ap.parse_args(argv)
+    if args.rows:
+        return rows(args)
     names = np.array(pr.NAMES)[np.flatnonzero(~np.isin(pr.NAMES, ["a2[0,0].re0", "a2[0,1].re0", "a2[1,0].re0",
                                                                    "a2[1,1].re0"]))]
     print(f"# bench_process_noise_mimo: runs {args.runs}, methods {' '.join(args.methods)}")
