@@ -214,7 +214,8 @@ def test_duplicated_experiment_halves_the_covariance(seed, domain, method):
     single = lptv.identify(u, y, na=2, nb=1, ka=s.ka, kb=s.kb, w0=s.w0, ts=s.ts, method=method,
                            tol=TOL, max_iter=MAX_ITER)
     assert np.array_equal(one.theta, single.theta) and np.array_equal(one.covariance, single.covariance)
-    two = _fit(s, [(u, y), (u, y)], method, None)
+    with pytest.warns(UserWarning, match=r"experiments\[0\] and experiments\[1\] hold the same data"):
+        two = _fit(s, [(u, y), (u, y)], method, None)
     assert two.n_experiments == 2 and two.lines.size == 2 * single.lines.size
     # WGTLS: the same GSVD problem (R factors of the stacked rows agree to rounding);
     # SML: both stop within the step rule of the same stationary point.
@@ -384,3 +385,25 @@ def test_cli_joint_fits_two_files_into_one_model(tmp_path):
     p = subprocess.run(cmd[:4] + [str(tmp_path / "low.npz"), str(tmp_path / "other.npz")] + cmd[6:],
                        capture_output=True, text=True, timeout=300)
     assert p.returncode == 2 and "period" in p.stderr and len(p.stderr.strip().splitlines()) == 1
+    # One file given twice: refused in one line, whichever way its path is spelled.
+    p = subprocess.run(cmd[:4] + [str(tmp_path / "low.npz"), str(tmp_path / "." / "low.npz")] + cmd[6:],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 2 and "is given twice" in p.stderr and len(p.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "joint2").exists()
+
+
+def test_the_same_data_given_twice_is_said():
+    """Two experiments holding identical spectra (one record given twice) are fitted, with a
+    warning that names them; several channels alike."""
+    s = system(0, "ct", False)
+    u, y = periods(s, 63, 4, np.arange(1, 20), np.random.default_rng(2))
+    kw = dict(na=2, nb=1, ka=s.ka, kb=s.kb, w0=s.w0)
+    other = periods(s, 63, 4, np.arange(1, 20), np.random.default_rng(3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UserWarning)
+        lptv.identify([(u, y), other], **kw)     # different records: no warning
+    with pytest.warns(UserWarning, match=r"experiments\[0\] and experiments\[2\] hold the same data"):
+        lptv.identify([(u, y), other, (u.copy(), y.copy())], **kw)
+    U, Y = u[:, :, None], y[:, :, None]
+    with pytest.warns(UserWarning, match=r"experiments\[0\] and experiments\[1\] hold the same data"):
+        lptv.identify([(U, Y), (U, Y)], na=2, nb=1, ka=s.ka, kb=s.kb, w0=s.w0)

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._validate import _array, as_float, as_int, as_lines, check_finite
 from ..model.mimo import MimoModel
+from ..spectra.frequency_data import refuse_repeated_experiments
 from ..spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
 from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
 from ..judgement.mimo_result import MimoIdentificationResult, residue_tests
@@ -141,7 +142,38 @@ def _experiments(u, y, w0, ts):
                              f"{nu} and {ny}")
         if d.w0 != out[0].w0 or (d.ts or 0.0) != (out[0].ts or 0.0):
             raise ValueError(f"experiments[{e}]: w0 and ts must be those of experiment 0")
+    refuse_repeated_experiments(out)
     return out
+
+
+SILENT_ALPHA = 0.01
+"""The size of :func:`silent_outputs`' test per output (Bonferroni over its rows)."""
+
+
+def silent_outputs(datas, rows_list) -> list:
+    """One sentence per output whose spectrum stands above its noise on none of the fitted rows:
+    |Y_p,l|^2 / C_pp,l is F(2, 2(P-1)) where the output is noise alone, and no row beyond its
+    1 - SILENT_ALPHA / n point (n rows) leaves no evidence that the output responds to the inputs
+    (a dead sensor, a channel that is noise): its coefficients are then fitted to noise."""
+    from .._dist import f_isf
+
+    ny = datas[0].n_outputs
+    z, dof = [], []
+    for d, rows in zip(datas, rows_list):
+        if d.periods < 2 or rows.size == 0:
+            continue
+        var = np.real(np.diagonal(d.C[rows], axis1=1, axis2=2))[:, :ny]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z.append(np.where(var > 0, np.abs(d.Y[rows]) ** 2 / var, np.inf))
+        dof.append(np.full(rows.size, 2.0 * (d.periods - 1)))
+    if not z:
+        return []
+    z, dof = np.concatenate(z), np.concatenate(dof)
+    limit = f_isf(SILENT_ALPHA / z.shape[0], 2.0, dof)
+    return [f"output {p} does not respond to the inputs: on none of the {z.shape[0]} fitted rows does its spectrum "
+            f"stand above its noise (F(2, 2(P-1)) at {SILENT_ALPHA:g} over the rows); its coefficients are fitted "
+            "to noise (a dead sensor, a channel not driven by these inputs?)"
+            for p in range(ny) if not np.any(z[:, p] > limit)]
 
 
 def _need_w0(w0):
@@ -252,6 +284,8 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
             data, cst, method, tol=tol, max_iter=max_iter, covariance=covariance == "analytic")
     except FitError as err:
         raise ValueError(f"u, y: {err}") from None
+    if noisy:
+        warns += silent_outputs(datas, rows_list)
     d = ny * ny
     if sv.size > d and sv[d] < 1.5 * sv[d - 1]:
         warns.append(f"the model is nearly unidentifiable: the generalised singular value {d + 1} is "

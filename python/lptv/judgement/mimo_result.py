@@ -142,10 +142,19 @@ class MimoIdentificationResult:
     def undetermined(self) -> Optional[str]:
         """Why the data do not determine the model or give no verdict (None when they do), as
         :attr:`lptv.IdentificationResult.undetermined`: no noise statistics (noise-free data or
-        P < 2), or the identifiability warning (the generalised singular value ny^2 + 1 within
-        1.5 times value ny^2: a second parameter direction explains the data nearly as well)."""
+        P < 2), a fit that did not converge, an output that does not respond to the inputs
+        (:func:`lptv.estimation.mimo_identify.silent_outputs`), or the identifiability warning (the
+        generalised singular value ny^2 + 1 within 1.5 times value ny^2: a second parameter
+        direction explains the data nearly as well)."""
         if self.noise_free or not self.tests:
             return "the data carry no noise statistics (noise-free or P < 2): the residues cannot be judged"
+        for w in self.warnings:
+            if "does not respond" in w:
+                return "the data do not determine the model: " + w
+        if not self.converged:
+            return (f"the fit did not converge in {self.iterations} iterations: the estimate is not a minimum of the "
+                    "cost, so its residues cannot vouch for the model (more iterations, another start, or fewer "
+                    "parameters)")
         for w in self.warnings:
             if "nearly unidentifiable" in w:
                 return "the data do not determine the model: " + w.split(": ", 1)[-1]

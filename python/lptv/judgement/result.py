@@ -408,7 +408,12 @@ class IdentificationResult:
         subspace, i.e. a second parameter direction explains the data as well as the estimate;
         for LS and TLS the GTLS problem on the same lines is tested). The verdict then does not
         call the model consistent. A fit of a DistortionResult's M = 4 realisations is not
-        determined either: its lack-of-fit test (:attr:`lack_of_fit`) cannot reach 1 %."""
+        determined either: its lack-of-fit test (:attr:`lack_of_fit`) cannot reach 1 %; nor is a fit
+        that did not converge (``converged`` False: ``max_iter`` reached)."""
+        if not self.converged:
+            return (f"the fit did not converge in {self.iterations} iterations: the estimate is not a minimum of the "
+                    "cost, so its residues cannot vouch for the model (more iterations, another start, or fewer "
+                    "parameters)")
         lof = self.lack_of_fit
         if lof is not None and not lof.can_reject:
             return (f"{lof.realisations} realisations cannot show a lack of fit at {100 * lof.alpha:g} % "

@@ -1,6 +1,7 @@
 """Frequency data with its nonparametric noise model (METHOD.md section 4)."""
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Optional
 
@@ -268,7 +269,23 @@ def experiments_of(items, w0, ts) -> list:
         if d.ts is not None and not np.isclose(d.ts, first.ts, rtol=1e-9, atol=0):
             raise ValueError(f"experiments disagree on the sample period of the discrete-time model: "
                              f"experiments[0] has ts = {first.ts:g}, experiments[{i}] has ts = {d.ts:g}")
+    refuse_repeated_experiments(datas)
     return datas
+
+
+def refuse_repeated_experiments(datas) -> None:
+    """A UserWarning when two experiments hold the same spectra (the same record given twice):
+    fitted as two independent experiments, one measurement counts twice and every std shrinks by
+    sqrt 2. Any data with ``U`` and ``Y`` arrays (one channel or several)."""
+    seen = {}
+    for i, d in enumerate(datas):
+        U, Y = np.asarray(d.U), np.asarray(d.Y)
+        key = (U.shape, Y.shape, U.tobytes(), Y.tobytes())
+        if key in seen and np.any(U != 0):
+            warnings.warn(f"experiments[{seen[key]}] and experiments[{i}] hold the same data (the same record "
+                          "given twice?): fitted as two independent experiments, one measurement counts twice "
+                          "and every std shrinks by sqrt 2; give each record once", UserWarning, stacklevel=4)
+        seen.setdefault(key, i)
 
 
 LINES_ALPHA = 0.01
