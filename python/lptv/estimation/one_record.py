@@ -140,7 +140,7 @@ def _record_periods(n_total, n0, name):
 EXCITED_RATIO = 1e-2
 """A line of the record's input carries content when its power is at least this share (-20 dB,
 the periodic route's line ratio) of the input's mean power per line; the fitted lines are
-excited when their mean power per line is (METHOD.md section 14)."""
+excited when their mean power per line is."""
 
 
 def _span(lines, dw) -> str:
@@ -287,6 +287,14 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
     seed : int or numpy Generator, optional
         The draws' random numbers (in a simulation study, not the stream that made the record's
         input: draws equal to the input's own samples are not independent of it).
+
+    Raises
+    ------
+    ValueError
+        Besides bad arguments, an input without content on the fitted lines and the lines their
+        harmonics reach (their mean power per line below 1 % of the input's over the record, as
+        an input above the continuous route's band): "u: the input is not excited on the fitted
+        lines ..., it is excited on lines ...".
 
     Examples
     --------
