@@ -924,6 +924,9 @@ def python_cases():
                match=names("model")),
           Case("montecarlo-excitation-str", "type", lambda: mc(excitation="abc"), match=names("excitation")),
           Case("montecarlo-methods", "value", lambda: mc(methods="ml"), match=names("methods")),
+          # more than any memory budget holds: refused before the seeds are listed or a record is made
+          Case("montecarlo-runs-beyond-memory", "size", lambda: mc(runs=2**31 - 1), match=names("runs")),
+          Case("montecarlo-periods-beyond-memory", "size", lambda: mc(periods=10**9), match=names("periods")),
           Case("montecarlo-checkpoint-int", "type", lambda: mc(checkpoint=3), match=names("checkpoint")),
           Case("montecarlo-checkpoint-file", "file", lambda: mc(checkpoint=write("a-file", "text")),
                match=names("checkpoint"))]
@@ -1249,6 +1252,10 @@ def cli_cases():
         add(f"montecarlo-model-{f}", mc + ("--model", "{dir}/" + f, "--excited", "1-10"), f)
     add("montecarlo-excited-huge", mc + ("--model", "{dir}/model.json", "--excited", "1-99999999999"), "--excited")
     add("montecarlo-excited-without-model", mc + ("--excited", "1-10"), "--excited")
+    add("montecarlo-runs-beyond-memory", ("montecarlo", "--runs", "2147483647", "--periods", "4", "--workers", "1",
+                                          "--out", "{dir}/mc"), "--runs")
+    add("montecarlo-periods-beyond-memory", ("montecarlo", "--runs", "1", "--periods", "1000000000", "--workers", "1",
+                                             "--out", "{dir}/mc"), "--periods")
     add("montecarlo-scheduler-not-an-address", mc[:5] + ("--scheduler", "not an address"),
         "(scheduler|executor|dask)")
     add("montecarlo-resume-nothing", mc + ("--resume",), "--resume")
