@@ -125,14 +125,18 @@ def write_fit(out, model, summary, report):
         model.context = context_of(summary, model)      # what lptv validate / simulate read back
         # written together or not at all: a full disk or a second command into the same folder
         # never leaves one fit's model beside another's report
+        no_plots = False
         with staged_folder(out, replaces=FIT_FILES) as stage:
             model.save(stage / "model.json")
             write_json(stage / "summary.json", summary)
             if report is not None:
-                report().write(stage)
+                try:
+                    report().write(stage)
+                except ImportError:     # the fit is kept whole without its report (as --no-report)
+                    no_plots = True
     except OSError as e:
         return e.filename or out, e.strerror or e
-    except ImportError:
+    if no_plots:
         return None, PLOTS_EXTRA
     print(f"wrote {out / 'model.json'}, " + (f"{out / 'report.html'}, " if report is not None else "")
           + f"{out / 'summary.json'}")
