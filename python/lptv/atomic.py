@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -44,6 +45,53 @@ def atomic_open(path, mode: str = "w", **kw):
             yield f
             f.flush()
             os.fsync(f.fileno())
+
+
+@contextlib.contextmanager
+def staged_folder(out, replaces=()):
+    """Yields a temporary folder inside the folder ``out`` to write a set of files into (a fit's
+    model, summary and report); when the block ends normally the files are moved into ``out``
+    together, under an exclusive lock on ``out`` (so that two commands writing into one folder at
+    once leave one set whole, the last, never a mix), and the names of ``replaces`` that the set
+    lacks are removed from ``out`` (a previous set's report, when this one has none). A block that
+    raises (a full disk, an interruption) leaves ``out`` as it was; an OSError then names the file
+    as it would be in ``out``."""
+    out = Path(os.fspath(out))
+    out.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".staged-", dir=out))
+    try:
+        try:
+            yield stage
+        except OSError as e:
+            if e.filename and str(e.filename).startswith(str(stage)):
+                e.filename = str(out / Path(e.filename).relative_to(stage))
+            raise
+        names = sorted(p.name for p in stage.iterdir())
+        with _locked(out):
+            for name in set(replaces) - set(names):
+                with contextlib.suppress(FileNotFoundError):
+                    (out / name).unlink()
+            for name in names:
+                os.replace(stage / name, out / name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _locked(folder):
+    """An exclusive advisory lock on the folder itself (flock on its descriptor; none where the
+    platform has no flock)."""
+    try:
+        import fcntl
+    except ImportError:      # Windows: the renames alone
+        yield
+        return
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)         # closing the descriptor releases the lock
 
 
 def _umask() -> int:

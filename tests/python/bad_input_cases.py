@@ -418,6 +418,11 @@ def python_cases():
         Case("identify_record-noise-unknown", "value", lambda: rec_call(noise="flat"), match=names("noise")),
         Case("identify_record-noise-negative", "range", lambda: rec_call(noise=-1.0), match=names("noise")),
         Case("identify_record-lines-zero", "range", lambda: rec_call(lines=[0, 5]), match=names("lines")),
+        Case("identify_record-u-zero", "value", lambda: rec_call(u=np.zeros(512)), match=names("u")),
+        # the input's content on lines 200..250 of the record, the fit on lines 1..60 (and their +-2 L)
+        Case("identify_record-u-not-excited-on-lines", "value",
+             lambda: rec_call(u=_record_cosines(range(200, 251), 512), lines=range(1, 61)),
+             match=r"^u: the input is not excited on the fitted lines"),
         Case("identify_record-ka-length", "shape", lambda: rec_call(ka=[1, 1]), match=names("ka")),
         Case("identify_record-na-zero", "range", lambda: rec_call(na=0), match=names("na")),
         Case("identify_record-max_iterations-zero", "range", lambda: rec_call(max_iterations=0),
@@ -919,6 +924,9 @@ def python_cases():
                match=names("model")),
           Case("montecarlo-excitation-str", "type", lambda: mc(excitation="abc"), match=names("excitation")),
           Case("montecarlo-methods", "value", lambda: mc(methods="ml"), match=names("methods")),
+          # more than any memory budget holds: refused before the seeds are listed or a record is made
+          Case("montecarlo-runs-beyond-memory", "size", lambda: mc(runs=2**31 - 1), match=names("runs")),
+          Case("montecarlo-periods-beyond-memory", "size", lambda: mc(periods=10**9), match=names("periods")),
           Case("montecarlo-checkpoint-int", "type", lambda: mc(checkpoint=3), match=names("checkpoint")),
           Case("montecarlo-checkpoint-file", "file", lambda: mc(checkpoint=write("a-file", "text")),
                match=names("checkpoint"))]
@@ -1081,6 +1089,13 @@ def _cosines(ms):
                for l, A, p in zip(ms.lines, ms.amplitudes, ms.phases))
 
 
+def _record_cosines(lines, n_samples, seed=0):
+    """Cosines on lines of a record's own DFT grid (periodic in the record: no leakage to others)."""
+    phases = np.random.default_rng(seed).uniform(0, 2 * np.pi, len(lines))
+    n = np.arange(n_samples)
+    return sum(np.cos(2 * np.pi * ((l * n) % n_samples) / n_samples + p) for l, p in zip(lines, phases))
+
+
 # ---------------------------------------------------------------------- command-line cases
 
 def cli_files(d: Path):
@@ -1096,6 +1111,10 @@ def cli_files(d: Path):
     (d / "v999.json").write_text(json.dumps(dict(lti().to_dict(), version=999)))
     (d / "model.json").write_text(json.dumps(lti().to_dict()))
     (d / "dir.npz").mkdir(exist_ok=True)
+    # one record of 8 periods of 64 samples whose input lies above the continuous fit's lines (1..63)
+    y = np.random.default_rng(1).standard_normal(512)
+    np.savetxt(d / "high.csv", np.c_[np.arange(512) / 64.0, _record_cosines(range(120, 250), 512), y],
+               delimiter=",", header="t,u,y", comments="")
 
 
 def cli_cases():
@@ -1144,6 +1163,8 @@ def cli_cases():
     for v in ("nan", "inf", "-1", "0", "abc"):
         add(f"identify-input-noise-{v}", ok + ("--one-record", "--period", "1", "--input-noise", v), "--input-noise")
     add("identify-input-noise-periods", ok + ("--input-noise", "0.1"), "--input-noise")
+    add("identify-one-record-not-excited", ("identify", "{dir}/high.csv", "--one-record", "--period", "1", "--na", "1",
+                                            "--nb", "0", "--out", "{dir}/high"), "u: the input is not excited")
     add("identify-method-bogus", ok + ("--method", "ml"), "--method")
     add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
     add("identify-noise-bogus", ok + ("--noise", "smooth"), "--noise")
@@ -1231,6 +1252,10 @@ def cli_cases():
         add(f"montecarlo-model-{f}", mc + ("--model", "{dir}/" + f, "--excited", "1-10"), f)
     add("montecarlo-excited-huge", mc + ("--model", "{dir}/model.json", "--excited", "1-99999999999"), "--excited")
     add("montecarlo-excited-without-model", mc + ("--excited", "1-10"), "--excited")
+    add("montecarlo-runs-beyond-memory", ("montecarlo", "--runs", "2147483647", "--periods", "4", "--workers", "1",
+                                          "--out", "{dir}/mc"), "--runs")
+    add("montecarlo-periods-beyond-memory", ("montecarlo", "--runs", "1", "--periods", "1000000000", "--workers", "1",
+                                             "--out", "{dir}/mc"), "--periods")
     add("montecarlo-scheduler-not-an-address", mc[:5] + ("--scheduler", "not an address"),
         "(scheduler|executor|dask)")
     add("montecarlo-resume-nothing", mc + ("--resume",), "--resume")

@@ -3,6 +3,7 @@ description that is not a model, a study too large for the machine. Each is refu
 with the argument (or the key) and the reason, a ValueError in Python and one line with a
 non-zero exit status on the command line. Each case failed before the change that made it pass."""
 import json
+import re
 import os
 import subprocess
 import sys
@@ -98,3 +99,35 @@ def test_the_stability_of_a_large_lti_model_of_several_channels_is_one_eigenprob
     a[0] -= 12.0 * np.eye(n)[..., None]                     # a0 = -6: a root in the right half plane
     unstable, undecided = stability_check(lptv.MimoModel(a, b, w0=1.0))
     assert undecided is None and "root of det A(s)" in unstable
+
+
+# ------------------------------------------------------------------------------ a study's sizes
+
+@pytest.mark.parametrize("args, message", [
+    (["--runs", "2147483647", "--workers", "1"],
+     r"^lptv montecarlo: error: --runs: a study of 2147483647 runs x 1 method needs about \S+ TB to hold "
+     r"their seeds and results, more than lptv's memory budget of "),
+    (["--periods", "1000000", "--workers", "2"],
+     r"^lptv montecarlo: error: --periods: a realisation of 1000000 periods of 2048 samples needs about 81.9 GB "
+     r".* x 2 at once \(workers\), more than lptv's memory budget of "),
+])
+def test_a_study_too_large_for_the_memory_is_refused_up_front(tmp_path, args, message):
+    """Before: 2^31 runs listed their seeds for minutes, a million periods failed every fit with a
+    MemoryError (exit 1). Refused at once, with what it would need against the budget."""
+    env = dict(os.environ, LPTV_MEMORY_BUDGET="8G")
+    p = subprocess.run([*LPTV, "montecarlo", *args, "--out", "mc"], capture_output=True, text=True,
+                       timeout=HANG, cwd=tmp_path, env=env)
+    assert p.returncode == 2, (p.returncode, p.stderr)
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and re.search(message, lines[0]) and "8.59 GB" in lines[0], p.stderr
+    assert not (tmp_path / "mc" / "parts").exists() or not any((tmp_path / "mc" / "parts").iterdir())
+
+
+def test_the_library_refuses_the_same_study_as_a_value_error():
+    m, ms = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1), lptv.multisine(range(1, 11), 256, seed=0)
+    with pytest.raises(ValueError, match=r"^runs: a study of 2147483647 runs x 2 methods needs about .* memory budget"):
+        lptv.montecarlo(m, ms, periods=4, runs=2**31 - 1, snr_in_db=40, snr_out_db=30, methods="tls,wgtls",
+                        executor="serial")
+    with pytest.raises(ValueError, match=r"^periods: a realisation of 100000000 periods of 256 samples needs "
+                                         r"about 1.02 TB"):
+        lptv.montecarlo(m, ms, periods=10**8, runs=2, snr_in_db=40, snr_out_db=30, executor="serial")

@@ -101,12 +101,14 @@ def test_a_fit_that_does_not_converge_warns_and_is_a_model_error():
     assert not r.converged and not r.model_ok and "did not converge" in r.verdict
 
 
-def _rig_csv(path, seed=2, L=8):
-    """The continuous-time record above as a rig writes it: time, force and displacement columns."""
+def _rig_csv(path, seed=2, L=8, band=(0.0, 0.25)):
+    """The continuous-time record above as a rig writes it: time, force and displacement columns;
+    the force's band in fractions of the Nyquist frequency."""
     rng = np.random.default_rng(seed)
     period, N0 = 10.0, 128
     w0, ts = 2 * np.pi / period, period / N0
-    freqs, amps = rng.uniform(0.05, 0.25 * np.pi / ts, 40), rng.standard_normal(40) / np.sqrt(20)
+    lo, hi = (b * np.pi / ts for b in band)
+    freqs, amps = rng.uniform(max(lo, 0.05), hi, 40), rng.standard_normal(40) / np.sqrt(20)
     phases = rng.uniform(0, 2 * np.pi, 40)
 
     def f(t):
@@ -261,3 +263,31 @@ def test_the_command_line_route_honours_or_refuses_every_option(tmp_path, capsys
     assert "one record of 6 periods of 128 samples" in capsys.readouterr().out
     html = (tmp_path / "s" / "report.html").read_text()
     assert "multiply every coefficient by the mean of a_na" in html and "divide every coefficient by the one" not in html
+
+
+def test_an_input_without_content_on_the_fitted_lines_is_refused(tmp_path, capsys):
+    """A force between 0.35 and 0.9 of Nyquist leaves the continuous route's lines (up to a quarter
+    of Nyquist) to the transient and the noise: refused as the periodic route refuses it ("the
+    input is not excited on the fitted lines", naming where it is), by the API and the command;
+    the same record fitted in discrete time, whose lines reach the force's, is not refused."""
+    import csv
+
+    from lptv.apps import cli
+
+    src = _rig_csv(tmp_path / "high.csv", band=(0.35, 0.9))
+    with open(src) as f:
+        rows = np.array([[float(v) for v in r] for r in list(csv.reader(f))[1:]])
+    u, y, ts = rows[:, 1], rows[:, 2], rows[1, 0] - rows[0, 0]
+    with pytest.raises(ValueError, match=r"^u: the input is not excited on the fitted lines 1 to 127 ") as e:
+        lptv.identify_record(u, y, w0=2 * np.pi / 10, ts=ts, na=2, nb=0, ka=[1, 0, 0], continuous=True)
+    assert "it is excited on lines " in str(e.value) and "continuous=False" in str(e.value)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = lptv.identify_record(u, y, w0=2 * np.pi / 10, ts=ts, na=2, nb=0, ka=[1, 0, 0])
+    assert r.lines.size == 511
+    base = ["identify", str(src), "--one-record", "--input", "force", "--output", "displacement", "--period", "10",
+            "--na", "2", "--nb", "0", "--ka", "1,0,0", "--kb", "0", "--out", str(tmp_path / "x")]
+    assert cli.main(base) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "u: the input is not excited on the fitted lines" in err, err
+    assert not (tmp_path / "x" / "model.json").exists()

@@ -148,8 +148,21 @@ def _main(argv=None) -> int:
         parser.print_help()
         return 0
     args = parser.parse_args(argv)
+    from lptv.apps.options import Interrupted, interruptible
+
     try:
-        return _run(parser, args)
+        # SIGINT (Ctrl-C) or SIGTERM: one line and the status a shell gives a process killed by it
+        # (130, 143); a batch or a study says itself what it keeps for --resume
+        with interruptible():
+            try:
+                return _run(parser, args)
+            except Interrupted as e:
+                import signal
+
+                kept = " (a fit's files are written together or not at all)" if args.command == "identify" else ""
+                print(f"lptv {args.command}: interrupted by {signal.Signals(e.signum).name}: stopped before it "
+                      f"finished{kept}", file=sys.stderr)
+                return e.status
     except ModuleNotFoundError as e:
         # an optional extra that is not installed: one line naming it, not a traceback
         if (e.name or "").split(".")[0] != "matplotlib":

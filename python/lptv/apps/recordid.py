@@ -26,7 +26,8 @@ import numpy as np
 
 from lptv import NumericalError, identify_record, read_measurements
 from lptv.apps.options import count, in_option_terms, integer, output_folder, refuse_given
-from lptv.apps.report import Report, write_json
+from lptv.apps.report import FIT_FILES, Report, write_json
+from lptv.atomic import staged_folder
 from lptv.apps import units
 from lptv.records.measurements import FileError
 from lptv.use.modelfile import context_of
@@ -111,7 +112,6 @@ def run(args, names=None) -> int:
         return _fail(src, e, names=names)
     extra = [str(w.message) for w in caught if str(w.message) not in res.warnings]
     out = Path(args.out) if args.out else Path(Path(src).stem + "-lptv")
-    out.mkdir(parents=True, exist_ok=True)
     L, N0 = meas.u.shape
     dropped = ([count(meas.trimmed, "sample")] if meas.trimmed else []) \
         + ([f"{count(meas.skipped, 'period')} (--skip-periods)"] if meas.skipped else [])
@@ -133,9 +133,8 @@ def run(args, names=None) -> int:
     res.model.context = context_of({"route": "one record", "input": meas.input, "output": meas.output, "fs": meas.fs,
                                     "samples_per_period": N0, "ka": ka, "kb": kb, "method": "output error",
                                     "noise": "residual"}, res.model)
-    res.model.save(out / "model.json")
     unit_of = units.coefficient_units(res.model, u_unit, y_unit)
-    write_json(out / "summary.json", {
+    summary = {
         "file": str(src), "route": "one record", "periods": L, "samples_per_period": N0, "fs": meas.fs,
         "trimmed": meas.trimmed, "continuous": not discrete, "verdict": res.verdict, "model_ok": res.model_ok,
         "model_errors": list(res.model_errors), "cost_ratio": res.cost_ratio, "converged": res.converged,
@@ -149,14 +148,21 @@ def run(args, names=None) -> int:
         "parameters_corrected_for_input_noise": None if not corrected else {
             n: {"value": float(v), "std": float(s), "bias": float(b)}
             for n, v, s, b in zip(res.eta_names, res.eta_corrected, res.std_corrected, res.input_noise_bias)},
-        "warnings": list(res.warnings) + extra})
+        "warnings": list(res.warnings) + extra}
     wrote = "model.json, summary.json"
-    if not getattr(args, "no_report", False):
-        try:
-            _report(res, src, L, N0, meas.fs, discrete, u_unit, y_unit).write(out)
-            wrote += ", report.html"
-        except ImportError:
-            wrote += " (no report.html: it needs matplotlib, pip install 'lptv[plots]')"
+    try:
+        # written together or not at all (a full disk, a second command into the same folder)
+        with staged_folder(out, replaces=FIT_FILES) as stage:
+            res.model.save(stage / "model.json")
+            write_json(stage / "summary.json", summary)
+            if not getattr(args, "no_report", False):
+                try:
+                    _report(res, src, L, N0, meas.fs, discrete, u_unit, y_unit).write(stage)
+                    wrote += ", report.html"
+                except ImportError:
+                    wrote += " (no report.html: it needs matplotlib, pip install 'lptv[plots]')"
+    except OSError as e:
+        return _fail(e.filename or out, e.strerror or e)
     print(f"wrote {out}/: {wrote}")
     return 0 if res.model_ok else MODEL_ERRORS
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lptv.atomic import atomic_open
+from lptv.atomic import atomic_open, staged_folder
 from lptv.use.modelfile import context_of
 
 
@@ -111,6 +111,10 @@ def write_json(path, obj):
 PLOTS_EXTRA = "writing report.html needs matplotlib, an optional extra: pip install 'lptv[plots]'"
 
 
+FIT_FILES = ("model.json", "summary.json", "report.html")
+"""The files of a fit that a later fit into the same folder replaces (or removes)."""
+
+
 def write_fit(out, model, summary, report):
     """Writes ``model.json``, ``summary.json`` and ``report.html`` (``report()`` builds the
     :class:`Report`; None: no report) into the folder ``out`` and says so; returns None, or
@@ -118,15 +122,21 @@ def write_fit(out, model, summary, report):
     a file's)."""
     out = Path(out)
     try:
-        out.mkdir(parents=True, exist_ok=True)
         model.context = context_of(summary, model)      # what lptv validate / simulate read back
-        model.save(out / "model.json")
-        write_json(out / "summary.json", summary)
-        if report is not None:
-            report().write(out)
+        # written together or not at all: a full disk or a second command into the same folder
+        # never leaves one fit's model beside another's report
+        no_plots = False
+        with staged_folder(out, replaces=FIT_FILES) as stage:
+            model.save(stage / "model.json")
+            write_json(stage / "summary.json", summary)
+            if report is not None:
+                try:
+                    report().write(stage)
+                except ImportError:     # the fit is kept whole without its report (as --no-report)
+                    no_plots = True
     except OSError as e:
         return e.filename or out, e.strerror or e
-    except ImportError:
+    if no_plots:
         return None, PLOTS_EXTRA
     print(f"wrote {out / 'model.json'}, " + (f"{out / 'report.html'}, " if report is not None else "")
           + f"{out / 'summary.json'}")

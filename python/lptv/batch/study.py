@@ -22,7 +22,8 @@ from ..estimation.identify import METHODS, identify
 from ..model.siso import Model
 from ..excitation.multisine import Multisine, spectrum, time_signal
 from ..estimation.crb import CramerRaoBound, crb
-from .executors import Failure, describe_executor, run_tasks
+from ..records.budget import _bytes, memory_budget
+from .executors import Failure, available_cores, describe_executor, run_tasks
 from .tables import MonteCarloTables
 
 
@@ -144,6 +145,36 @@ class MonteCarloResult(MonteCarloTables):
         return 60.0 * self.n_fits / self.elapsed if self.elapsed > 0 else float("nan")
 
 
+RUN_BYTES, METHOD_BYTES, PARAMETER_BYTES = 500, 700, 150
+"""A study's memory per run (its seed and task), per run and method (its row of fits and the task's
+answer) and per run, method and parameter (estimates, std and their table's row), measured."""
+SAMPLE_BYTES = 40
+"""A realisation's memory per sample of its P x N periods (the noisy input and output, their
+noises, spectra and the fit's arrays), measured at N = 2^14 .. 2^18 (about 39 bytes)."""
+
+
+def _within_memory(runs, n_methods, n_parameters, periods, n_samples, executor, workers):
+    """Refuses a study whose results, or whose realisations in flight, exceed the memory budget
+    (lptv.memory_budget), before anything is built: 2^31 runs took minutes to list their seeds,
+    a million periods failed every fit with a MemoryError."""
+    budget = memory_budget()
+    where = "lptv's memory budget of " + _bytes(budget) + " (half the machine's memory, or LPTV_MEMORY_BUDGET)"
+    kept = runs * (RUN_BYTES + n_methods * (METHOD_BYTES + PARAMETER_BYTES * n_parameters))
+    if kept > budget:
+        raise ValueError(f"runs: a study of {runs} runs x {n_methods} method{'s' if n_methods > 1 else ''} needs about "
+                         f"{_bytes(kept)} to hold their seeds and results, more than {where}: fewer runs (several "
+                         "studies with their own seeds)")
+    local = isinstance(executor, str) and executor == "processes"
+    at_once = 1 if not local else available_cores() if workers is None else \
+        int(workers) if isinstance(workers, (int, np.integer)) and workers > 0 else 1
+    one = SAMPLE_BYTES * periods * n_samples
+    if one * at_once + kept > budget:
+        many = f" x {at_once} at once (workers)" if at_once > 1 else ""
+        raise ValueError(f"periods: a realisation of {periods} periods of {n_samples} samples needs about "
+                         f"{_bytes(one)} (its noisy record, spectra and fit){many}, more than {where}: fewer "
+                         "periods or samples" + (", or fewer workers" if at_once > 1 else ""))
+
+
 def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, periods: int,
                runs: int, snr_in_db: float, snr_out_db: float, methods="wgtls",
                pole_in: float = 0.0, pole_out: float = 0.0, correlation: float = 0.0,
@@ -235,6 +266,7 @@ def montecarlo(model: Model, excitation: Union[Multisine, Sequence[float]], *, p
             raise ValueError(f"seed must be an int, a sequence of ints or a SeedSequence: {e}") from None
 
     N = ms.n_samples
+    _within_memory(runs, len(methods), 2 * (model.a.size + model.b.size), periods, N, executor, workers)
     y0 = time_signal(simulate(model, ms.spectrum), N)
     var_u, var_y, cov_yu = noise_variances(ms.signal, y0, **noise)
     bound = crb(model, ms, var_u=var_u, var_y=var_y, cov_yu=cov_yu, periods=periods, lines=lines)

@@ -137,6 +137,50 @@ def _record_periods(n_total, n0, name):
     return n_total // n0
 
 
+EXCITED_RATIO = 1e-2
+"""A line of the record's input carries content when its power is at least this share (-20 dB,
+the periodic route's line ratio) of the input's mean power per line; the fitted lines are
+excited when their mean power per line is."""
+
+
+def _span(lines, dw) -> str:
+    n = len(lines)
+    if n == 1:
+        return f"line {lines[0]} ({lines[0] * dw:.4g} rad/s)"
+    return f"lines {lines[0]} to {lines[-1]} ({n} lines, {lines[0] * dw:.4g} to {lines[-1] * dw:.4g} rad/s)"
+
+
+def _check_excited(U, lines, L, kmax, continuous, dw):
+    """Refuses a record whose input has no content on the fitted lines and the lines their
+    harmonics reach (l + k L, |k| <= kmax): the fit would read the output's transient and noise
+    alone, and its verdict, a regression on that input, could not see it."""
+    N = U.size
+    half = np.arange(1, (N + 1) // 2)
+    power = np.abs(U[half]) ** 2
+    mean = power.mean() if power.size else 0.0
+    reach = (np.asarray(lines)[:, None] + L * np.arange(-kmax, kmax + 1)[None, :]).ravel() % N
+    reach = np.minimum(reach, N - reach)
+    region = np.unique(reach[(reach >= 1) & (reach < (N + 1) // 2)])
+    where = f"the fitted {_span(list(lines), dw)}" + (f" and their +-{kmax} w0 neighbours" if kmax else "")
+    if not mean > 0 or not np.isfinite(mean):
+        raise ValueError("u: the input spectrum is zero on every line of the record (a constant, dead or "
+                         "disconnected input channel): the system is not excited, so nothing can be identified")
+    inside = power[region - 1].mean()
+    if inside >= EXCITED_RATIO * mean:
+        return
+    mask = np.zeros(half.size, bool)
+    mask[region - 1] = True
+    elsewhere = half[(power >= EXCITED_RATIO * mean) & ~mask]
+    fix = ("; a continuous-time fit reads the lines up to a quarter of the Nyquist frequency: an input with "
+           "content there, a discrete-time model (continuous=False), or lines where the input is excited "
+           "(lines=...)" if continuous else "; fit lines at or next to those the input excites (lines=...)")
+    level = (f"its power per line on the fitted ones is {10 * np.log10(mean / inside):.0f} dB below its mean over the record"
+             if inside > 0 else "its spectrum is zero on the fitted ones")
+    raise ValueError(f"u: the input is not excited on {where}: "
+                     + (f"it is excited on {_span(list(elsewhere), dw)}, " if elsewhere.size else "")
+                     + f"{level}, so the fit would read the output's transient and noise alone" + fix)
+
+
 def local_polynomial_noise(U, Y, L, lines, *, branches: int, degree: int = 2, half_width: Optional[int] = None,
                            transient: bool = True):
     """Output noise variance per line by the local polynomial method on the record's grid.
@@ -244,6 +288,14 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         The draws' random numbers (in a simulation study, not the stream that made the record's
         input: draws equal to the input's own samples are not independent of it).
 
+    Raises
+    ------
+    ValueError
+        Besides bad arguments, an input without content on the fitted lines and the lines their
+        harmonics reach (their mean power per line below 1 % of the input's over the record, as
+        an input above the continuous route's band): "u: the input is not excited on the fitted
+        lines ..., it is excited on lines ...".
+
     Examples
     --------
     >>> import numpy as np, lptv
@@ -300,6 +352,7 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
     U = np.fft.fft(u) / N
     Y = np.fft.fft(y) / N
     kmax = max(ka_l + kb_l)
+    _check_excited(U, lines, L, kmax, continuous, w0 / L)
     nT = (t_degree + 1 if continuous else n_order) if transient else 0
     n_eta = len(par.free_indices)        # the free real parameters (eta without Re a_na,0 = 1)
     if 2 * lines.size <= n_eta + nT:
