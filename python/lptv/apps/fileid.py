@@ -39,7 +39,6 @@ Example (the paper's simulation example as a measurement file, then its identifi
 from __future__ import annotations
 
 import argparse
-import os
 import re
 import sys
 import warnings
@@ -188,15 +187,6 @@ def _fail(name, problem, status=2) -> int:
 def run(args) -> int:
     from lptv.apps import mimoid
 
-    seen = {}
-    for i, f in enumerate(args.files):
-        key = os.path.realpath(f)
-        if key in seen:
-            print(f"lptv identify: error: {f} is given twice (files {seen[key] + 1} and {i + 1}): fitted as two "
-                  "experiments one measurement would count twice and every std shrink by sqrt 2; give each "
-                  "record once", file=sys.stderr)
-            return 2
-        seen[key] = i
     if mimoid.several_channels(args):      # --input f1,f2 / --output x1,x2: one fit of all the files
         if getattr(args, "reference", None):
             print("lptv identify: error: --reference: the period check by a reference column is built for one "

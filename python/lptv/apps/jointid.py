@@ -22,7 +22,7 @@ import numpy as np
 
 from lptv import FrequencyData, NumericalError, identify, parameter_table, plots
 from lptv.apps.options import fundamental, parse_counts, parse_known, parse_lines, positive, read_record
-from lptv.apps.options import verdict_status
+from lptv.apps.options import refuse_same_file, verdict_status
 from lptv.apps.report import Report, model_figures, write_fit
 from lptv.records.measurements import FileError
 
@@ -65,6 +65,7 @@ def run(args) -> int:
             raise FileError(f"--max-iter must be >= 0, got {args.max_iter}")
         positive(args.tol, "--tol")
         records = _records(args)
+        refuse_same_file(args.files)
     except (FileError, ValueError) as e:
         return _fail(e)
     files = [r[0] for r in records]

@@ -35,7 +35,7 @@ import numpy as np
 import lptv
 from lptv import NumericalError
 from lptv.apps.options import (MODEL_REJECTED, NOT_DETERMINED, OPTION_NAMES, count, fundamental, in_option_terms, integer,
-                               output_folder, parse_counts, parse_lines, positive, read_options)
+                               output_folder, parse_counts, parse_lines, positive, read_options, refuse_same_file)
 from lptv.apps import inspectrec, units
 from lptv.apps.mimoreport import physical_table
 from lptv.apps.report import write_fit
@@ -162,6 +162,7 @@ def run(args) -> int:
         ka, kb = parse_counts(args.ka, "--ka"), parse_counts(args.kb, "--kb")
         scale = units.parse_scale(getattr(args, "scale", None))
         records, w0, ts = read_experiments(args)
+        refuse_same_file(args.files)
         if not mimo_fit_available():
             raise FileError(NEEDS_FIT)
     except (FileError, ValueError) as e:

@@ -82,6 +82,18 @@ def refuse_given(args, refused: dict, route: str):
             raise FileError(f"--{dest.replace('_', '-')} is not for {route}: {reason}")
 
 
+def refuse_same_file(files) -> None:
+    """FileError when one file is given twice to a fit of several experiments (its path spelled
+    either way): fitted as two experiments, one measurement would count twice."""
+    seen = {}
+    for i, f in enumerate(files):
+        key = os.path.realpath(f)
+        if key in seen:
+            raise FileError(f"{f} is given twice (files {seen[key] + 1} and {i + 1}): fitted as two experiments one "
+                            "measurement would count twice and every std shrink by sqrt 2; give each record once")
+        seen[key] = i
+
+
 def integer(value, opt, minimum=0, maximum=INT_MAX):
     """An integer option's value within [minimum, maximum], or a FileError naming the option."""
     if value is None:
