@@ -60,6 +60,7 @@ SMOKE = {
     "bench_moderation_core.py": ["1"],
     "bench_noise_route.py": ["--runs", "2", "--periods", "4", "--workers", "1"],
     "bench_process_noise.py": ["--runs", "2", "--periods", "4", "--loop", "feedback"],
+    "bench_process_noise_mimo.py": ["--runs", "2", "--periods", "4", "--loop", "feedback"],
     "bench_noise_cost.py": ["--rounds", "1"],
     "bench_multi_experiment.py": ["3"],
     "bench_record.py": ["--runs", "3", "--periods", "4"],
