@@ -880,10 +880,19 @@ ExactFit minimise_exact_cost(const std::vector<ExactLikelihood>& liks, const Par
 Eigen::MatrixXd ExactLikelihood::residue_covariance(const Eigen::VectorXcd& theta) const {
   const Factor f = factor(theta);
   const Eigen::Index n = f.Lb.cols();
-  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (Eigen::Index i = j; i <= std::min<Eigen::Index>(n - 1, j + kd_); ++i) L(i, j) = f.Lb(i - j, j);
-  return L * L.transpose();
+  const Eigen::Index kd = kd_;
+  // S = L L^T with L lower banded (kd sub-diagonals, L(i, c) = Lb(i - c, c)): S is banded too,
+  // S(i, j) = sum of L(i, c) L(j, c) over c in [i - kd, j] for j <= i <= j + kd (O(n kd^2)).
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = j; i <= std::min<Eigen::Index>(n - 1, j + kd); ++i) {
+      double sum = 0.0;
+      for (Eigen::Index c = std::max<Eigen::Index>(0, i - kd); c <= j; ++c) sum += f.Lb(i - c, c) * f.Lb(j - c, c);
+      S(i, j) = sum;
+      S(j, i) = sum;
+    }
+  }
+  return S;
 }
 
 Eigen::MatrixXd eta_covariance(const Parametrisation& p, const Eigen::MatrixXd& cov_free) {

@@ -244,20 +244,37 @@ Eigen::MatrixXd ModeratedNoise::error_covariance(const std::vector<int>& lines) 
   }
   const int P = data.periods;
   if (P < 2) return Eigen::MatrixXd::Zero(k, k);
-  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k, L + 1);
+  // Row i of the mixing matrix M (each moderated variance's weights on the sample variances)
+  // is nonzero only on lines lo_i..hi_i (l_i +- half_width): the rows kept as those windows,
+  // and (M M^T)(i, j) summed over the overlap of two windows (O(k^2 + k w^2), not O(k^2 L)).
+  const Eigen::Index width = 2 * static_cast<Eigen::Index>(half_width) + 1;
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(k, width);
+  std::vector<long long> first(k), last(k);
   for (Eigen::Index i = 0; i < k; ++i) {
     const int l = lines[i];
     const double w = own_weight.size() ? own_weight[l] : 1.0;
     const long long lo = std::max<long long>(0, static_cast<long long>(l) - half_width);
     const long long hi = std::min<long long>(L, static_cast<long long>(l) + half_width);
+    first[i] = lo;
+    last[i] = hi;
     int n = 0;
     for (long long j = lo; j <= hi; ++j) n += (j != l && (neighbour.size() == 0 || neighbour[j])) ? 1 : 0;
     const double share = (1.0 - w) / std::max(n, 1);
     for (long long j = lo; j <= hi; ++j)
-      if (j != l && (neighbour.size() == 0 || neighbour[j])) M(i, j) = share;
-    M(i, l) = w;
+      if (j != l && (neighbour.size() == 0 || neighbour[j])) M(i, j - lo) = share;
+    M(i, l - lo) = w;
   }
-  return (2.0 / (2.0 * (P - 1))) * (M * M.transpose());
+  const double scale = 2.0 / (2.0 * (P - 1));
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(k, k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    for (Eigen::Index j = i; j < k; ++j) {
+      const long long lo = std::max(first[i], first[j]), hi = std::min(last[i], last[j]);
+      double sum = 0.0;
+      for (long long c = lo; c <= hi; ++c) sum += M(i, c - first[i]) * M(j, c - first[j]);
+      out(i, j) = out(j, i) = scale * sum;
+    }
+  }
+  return out;
 }
 
 ModeratedNoise moderated_noise(const FrequencyData& data, int half_width) {

@@ -371,3 +371,26 @@ def test_library_works_without_the_batch_extra():
     assert out.stdout.splitlines() == [
         "MonteCarloResult.summary needs the package 'pandas': pip install 'lptv[batch]'",
         "a Dask executor needs the package 'distributed': pip install 'lptv[batch]'"]
+
+
+def test_montecarlo_command_checks_its_options_before_importing_the_tables(tmp_path):
+    """`lptv montecarlo` checks that pandas is installed without importing it (a second), so that a
+    bad option is refused at once; with pandas hidden it names the extra, exit 2."""
+    code = textwrap.dedent("""
+        import sys
+        from lptv.apps import cli
+        rc = cli.main(["montecarlo", "--runs", "1", "--periods", "4", "--workers", "0", "--out", sys.argv[1]])
+        print(rc, "pandas" in sys.modules)
+        class Hide:
+            def find_spec(self, name, path=None, target=None):
+                if name.split(".")[0] == "pandas":
+                    raise ImportError("hidden: " + name)
+        sys.meta_path.insert(0, Hide())
+        print(cli.main(["montecarlo", "--runs", "1", "--periods", "4", "--out", sys.argv[1]]))
+    """)
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "mc")], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines() == ["2 False", "2"], out
+    assert "--workers must be >= 1, got 0" in out.stderr
+    assert "lptv montecarlo's tables needs the package 'pandas': pip install 'lptv[batch]'" in out.stderr

@@ -17,8 +17,8 @@ import pytest
 
 import lptv
 from lptv.apps import cli
-from outside_records import (discrete_lines, discrete_lptv, filtered_noise, mass_spring_damper, odd_lines,
-                             write_csv)
+from outside_records import (discrete_lines, discrete_lptv, filtered_noise, mass_spring_damper,
+                             mass_spring_damper_many, odd_lines, write_csv)
 
 # (period s, fs Hz, periods, noise, excited lines): T fs samples a period; the second's lines are
 # multiples of 3, so its input repeats every T / 3 = 140 samples and only the output every T.
@@ -271,9 +271,9 @@ def test_the_transient_advice_leaves_no_bias_and_identify_says_when_one_is_left(
     (dropping the 4 that differ visibly from the steady ones left +0.9 std); lptv identify with
     fewer dropped names the transient and the periods to drop."""
     z, advice = [], []
-    for seed in range(24):
-        t, f, x = mass_spring_damper(4.0, 50.0, 10, lines=odd_lines(1, 20, seed=7), noise=0.01, seed=seed,
-                                     damping=0.54)
+    rigs = mass_spring_damper_many(4.0, 50.0, 10, lines=odd_lines(1, 20, seed=7), noise=0.01, seeds=range(24),
+                                   damping=0.54)
+    for t, f, x in rigs:
         src = tmp_path / "rig.csv"
         np.savetxt(src, np.column_stack([t, f, x]), delimiter=",", header="time,force,displacement", comments="")
         insp = lptv.inspect(src, u="force", y="displacement")

@@ -137,9 +137,9 @@ def run(args) -> int:
         # the tables need pandas (and Parquet pyarrow): checked before any fit runs, not after
         from lptv.batch.executors import require
 
-        require("pandas", "lptv montecarlo's tables")
+        require("pandas", "lptv montecarlo's tables", load=False)
         if args.format == "parquet":
-            require("pyarrow", "--format parquet")
+            require("pyarrow", "--format parquet", load=False)
         model, ms, lines, what = _design(args)
         executor, workers = executor_of(args)
         parts = Path(args.out) / "parts"

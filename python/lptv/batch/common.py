@@ -20,11 +20,18 @@ class Failure:
     """The traceback (or the reason the chunk was lost)."""
 
 
-def require(module: str, what: str):
-    """Import an optional dependency, or raise ImportError naming the extra that brings it."""
+def require(module: str, what: str, *, load: bool = True):
+    """Import an optional dependency, or raise ImportError naming the extra that brings it. With
+    ``load=False`` only whether it is installed is checked (without the import's cost: a command
+    that refuses a bad option then does so at once); returns None."""
     import importlib
+    import importlib.util
 
     try:
+        if not load:
+            if importlib.util.find_spec(module) is None:
+                raise ImportError(module)
+            return None
         return importlib.import_module(module)
     except ImportError:
         raise ImportError(f"{what} needs the package '{module.split('.')[0]}': {EXTRA}") from None
