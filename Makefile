@@ -149,10 +149,16 @@ python: deps-build venv-demo
 # (--dist loadfile: a module's fixtures are computed once and its tests run in their order; the
 # files with the most tests go first). --durations: the slowest tests, for bench/RESULTS.md's
 # table of the suite. Serial: make pytest PYTEST_WORKERS=0. One file: PYTEST_ARGS=test_fds.py.
+# One BLAS thread per worker (PYTEST_BLAS_THREADS): the workers already fill the cores, and
+# OpenBLAS's threads spinning beside another worker's slow the NumPy reference's dense tests
+# (test_mimo_fit's SML reference comparison: 12.8 s in a two-worker run with one BLAS thread,
+# 69 s in one without the limit, on a machine that was also busy).
 PYTEST_WORKERS ?= $(JOBS)
+PYTEST_BLAS_THREADS ?= 1
 PYTEST_ARGS ?=
 pytest: deps venv python
-	cd tests/python && ../../$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile \
+	cd tests/python && OPENBLAS_NUM_THREADS=$(PYTEST_BLAS_THREADS) OMP_NUM_THREADS=$(PYTEST_BLAS_THREADS) \
+	  ../../$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile \
 	  --durations=20 $(PYTEST_ARGS)
 
 # Every benchmark executable (built by make cpp) and script once at small sizes (bench/smoke.py:
