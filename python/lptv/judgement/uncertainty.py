@@ -110,6 +110,14 @@ class HtfBand:
         return q <= -2.0 * np.log(1.0 - self.level)   # chi2_2 quantile
 
 
+def _branches(model, w, ks) -> np.ndarray:
+    """G_k(w) for each k of ``ks``, shape (len(ks), w.size): one harmonic balance for every
+    branch where the model has one (a one-channel LPTV model), else branch by branch."""
+    if hasattr(model, "_branches") and not model.is_lti:
+        return model._branches(w, [int(k) for k in ks])
+    return np.stack([model.freqresp(w, branch=int(k)) for k in ks])
+
+
 def htf_band(res, lines=None, branches=(0,), *, level: float = 0.95) -> HtfBand:
     """The HTF branches G_k(j w_l) of ``res.model`` at the input ``lines`` (default: the fit's
     excited lines, |U_l|^2 > 100 var U_l) with their covariance (METHOD.md section 22)."""
@@ -131,14 +139,14 @@ def htf_band(res, lines=None, branches=(0,), *, level: float = 0.95) -> HtfBand:
         raise ValueError(f"lines must be a non-empty 1-D array of positive integers, got {lines!r}")
     ks = np.array([as_int(k, "branches", minimum=-4096) for k in np.atleast_1d(branches)])
     w = lines * model.w0
-    G = np.stack([model.freqresp(w, branch=int(k)) for k in ks])
+    G = _branches(model, w, ks)
     Jr = np.zeros(G.shape + (2, len(names)))
     for j, name in enumerate(names):
         if cov[j, j] <= 0:
             continue
         h = 1e-6 * max(abs(eta[j]), 1e-3)
         mp, mm = perturbed_model(model, name, h), perturbed_model(model, name, -h)
-        dG = np.stack([(mp.freqresp(w, branch=int(k)) - mm.freqresp(w, branch=int(k))) / (2 * h) for k in ks])
+        dG = (_branches(mp, w, ks) - _branches(mm, w, ks)) / (2 * h)
         Jr[..., 0, j], Jr[..., 1, j] = dG.real, dG.imag
     C = np.einsum("...ip,pq,...jq->...ij", Jr, cov, Jr)
     return HtfBand(lines=lines, w=w, branches=ks, G=G, covariance=C, level=float(level))

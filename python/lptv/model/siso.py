@@ -189,31 +189,45 @@ class Model:
             x = np.exp(1j * w * self.ts) if self.discrete else 1j * w
             num, den = self.to_tf()
             return np.polyval(num, x) / np.polyval(den, x)
+        return self._branches(w, [branch], harmonics)[0]
+
+    def _branches(self, w, branches, harmonics=None) -> np.ndarray:
+        """G_k(w) of an LPTV model for each k of ``branches`` (checked integers), shape
+        (len(branches), w.size): one harmonic balance per frequency serves every branch, the
+        balances of all frequencies solved as one stack (LAPACK's gesv on each matrix)."""
         L = max(32, 8 * (self.ka + self.kb)) if harmonics is None else int(harmonics)
-        if abs(branch) > L:
-            raise ValueError(f"branch {branch} is beyond the {L} harmonics of the balance")
+        for branch in branches:
+            if abs(branch) > L:
+                raise ValueError(f"branch {branch} is beyond the {L} harmonics of the balance")
+        w = np.asarray(w, float)
+        M = 2 * L + 1
+        block = max(1, 2**22 // (M * M))     # frequencies per stack: about 64 MB of matrices
+        if w.size > block:
+            return np.concatenate([self._branches(w[i:i + block], branches, L)
+                                   for i in range(0, w.size, block)], axis=1)
         a, b, Ka, Kb = self.a, self.b, self.ka, self.kb
         ks = np.arange(-L, L + 1)
-        out = np.empty(w.size, complex)
-        for i, wi in enumerate(w):
-            x = np.exp(1j * (wi + ks * self.w0) * self.ts) if self.discrete else 1j * (wi + ks * self.w0)
-            A = np.zeros((ks.size, ks.size), complex)
-            for n in range(self.na + 1):
-                pw = x ** n
-                for h in range(-Ka, Ka + 1):
-                    c = a[n, Ka + h]
-                    if c == 0:
-                        continue
-                    # row k, column j = k - h: a_{n,h} x_j^n
-                    idx = np.arange(max(0, h), min(ks.size, ks.size + h))
-                    A[idx, idx - h] += c * pw[idx - h]
-            rhs = np.zeros(ks.size, complex)
-            x0 = np.exp(1j * wi * self.ts) if self.discrete else 1j * wi
-            for m in range(self.nb + 1):
-                for h in range(-Kb, Kb + 1):
-                    rhs[L + h] += b[m, Kb + h] * x0 ** m
-            out[i] = np.linalg.solve(A, rhs)[L + branch]
-        return out
+        if w.size == 0:
+            return np.empty((len(branches), 0), complex)
+        arg = w[:, None] + ks[None, :] * self.w0
+        x = np.exp(1j * arg * self.ts) if self.discrete else 1j * arg
+        A = np.zeros((w.size, M, M), complex)
+        for n in range(self.na + 1):
+            pw = x ** n
+            for h in range(-Ka, Ka + 1):
+                c = a[n, Ka + h]
+                if c == 0:
+                    continue
+                # row k, column j = k - h: a_{n,h} x_j^n
+                idx = np.arange(max(0, h), min(M, M + h))
+                A[:, idx, idx - h] += c * pw[:, idx - h]
+        rhs = np.zeros((w.size, M), complex)
+        x0 = np.exp(1j * w * self.ts) if self.discrete else 1j * w
+        for m in range(self.nb + 1):
+            for h in range(-Kb, Kb + 1):
+                rhs[:, L + h] += b[m, Kb + h] * x0 ** m
+        X = np.linalg.solve(A, rhs[..., None])[..., 0]
+        return np.stack([X[:, L + int(k)] for k in branches])
 
     @classmethod
     def _from_core(cls, cpp: "_core.Model") -> "Model":

@@ -408,9 +408,12 @@ def _branches_panel(ax, res, sets, scale, n_points):
     if model.discrete:
         w_hi = min(w_hi, np.pi / model.ts)
     w = np.logspace(np.log10(w_lo), np.log10(w_hi), n_points)
+    from ..judgement.uncertainty import _branches
+
     order = sorted(range(-K, K + 1), key=abs)
-    for k in order:
-        ax.plot(w * scale, _db(model.freqresp(w, branch=k)), "-", lw=1.2, color=_branch_color(k),
+    curves = _branches(model, w, order)
+    for k, G in zip(order, curves):
+        ax.plot(w * scale, _db(G), "-", lw=1.2, color=_branch_color(k),
                 label=f"G_{k:+d}" if k else "G_0")
     _branch_bands(ax, res, np.unique(lines), order, scale)
     why = []
