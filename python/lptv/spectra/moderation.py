@@ -188,6 +188,17 @@ SMOOTH_LAG_SIGMAS = 2.5
 exceeds this many of its standard errors 1 / sqrt(n) (n pairs of lines)."""
 
 
+def _window_sum(a, kernel):
+    """Per i: sum over x of a[i + x] kernel[x + S] for x = -S..S (kernel of length 2 S + 1, its
+    middle entry ignored), a[j] = 0 outside 0..len(a) - 1."""
+    k = kernel.copy()
+    k[k.size // 2] = 0.0
+    if a.size < k.size:     # np.convolve's 'same' takes the longer input's length
+        pad = k.size
+        return np.convolve(np.concatenate([np.zeros(pad), a, np.zeros(pad)]), k[::-1], mode="same")[pad:pad + a.size]
+    return np.convolve(a, k[::-1], mode="same")
+
+
 def _trend_residuals(v, keep, W):
     """Per line of ``v`` (variances of lines 1..Lmax-1): log v minus the value at the line of the
     least-squares quadratic in the offset x fitted to the other lines' log v over |x| <= 2 W
@@ -196,30 +207,27 @@ def _trend_residuals(v, keep, W):
     ok = keep & (v > 0)
     z = np.where(ok, np.log(np.where(ok, v, 1.0)), 0.0)
     S = 2 * W
-    C = np.zeros((5, m))
-    T = np.zeros((3, m))
-    left = np.zeros(m)
-    right = np.zeros(m)
-    idx = np.arange(m)
-    for x in range(-S, S + 1):
-        if x == 0:
-            continue
-        j = idx + x
-        inside = (j >= 0) & (j < m)
-        use = inside & ok[np.where(inside, j, 0)]
-        zx = np.where(use, z[np.where(inside, j, 0)], 0.0)
-        for q in range(5):
-            C[q] += use * float(x) ** q
-        for q in range(3):
-            T[q] += zx * float(x) ** q
-        (left if x < 0 else right)[:] += use
+    # the window sums over the offsets x = -S..S (x = 0 left out) as correlations with the
+    # kernels x^q: sum_x ok[i + x] x^q and sum_x z[i + x] x^q, lines outside 0..m-1 absent
+    x = np.arange(-S, S + 1, dtype=float) / S     # offsets scaled to -1..1 (the fit's value at 0 unchanged)
+    okf = ok.astype(float)
+    C = np.stack([_window_sum(okf, x ** q) for q in range(5)])
+    T = np.stack([_window_sum(z, x ** q) for q in range(3)])
+    left = _window_sum(okf, (x < 0).astype(float))
+    right = _window_sum(okf, (x > 0).astype(float))
     good = ok & (left >= W) & (right >= W)
-    A = np.stack([np.stack([C[0], C[1], C[2]], -1), np.stack([C[1], C[2], C[3]], -1),
-                  np.stack([C[2], C[3], C[4]], -1)], -2)[good]
     r = np.full(m, np.nan)
     if good.any():
-        alpha = np.linalg.solve(A, T[:, good].T[..., None])[:, 0, 0]
-        r[good] = z[good] - alpha
+        # the first unknown of the 3 x 3 normal equations (Hankel in the moments C), by Cramer's
+        # rule on the scaled offsets (entries of one size)
+        c0, c1, c2, c3, c4 = C[:, good]
+        t0, t1, t2 = T[:, good]
+        m00, m01, m02 = c2 * c4 - c3 * c3, c1 * c4 - c2 * c3, c1 * c3 - c2 * c2
+        det = c0 * m00 - c1 * m01 + c2 * m02
+        # a window with the points of fewer than three offsets (half_width 1) fits no quadratic
+        fits = det > 1e-10 * c0 * c2 * c4
+        alpha = (t0 * m00 - c1 * (t1 * c4 - c3 * t2) + c2 * (t1 * c3 - c2 * t2)) / np.where(fits, det, 1.0)
+        r[good] = np.where(fits, z[good] - alpha, np.nan)
     return r
 
 
