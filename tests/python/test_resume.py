@@ -23,7 +23,7 @@ from lptv.examples import paper_measurements
 pd = pytest.importorskip("pandas")
 
 LPTV = [sys.executable, "-m", "lptv"]
-RUNS = 1200
+RUNS = 600      # 1.2 s of fits on two workers: ~50 times the 20 ms the tests poll at before a signal
 MODEL = lptv.Model([[2.0], [1.0]], [[1.0]], w0=0.1)          # 1 / (s + 2): fits of ~3 ms
 
 
