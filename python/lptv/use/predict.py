@@ -176,10 +176,20 @@ class _Interpolant:
         self.w = 2 * np.pi * fs * np.arange(C.shape[0]) / n
         self.D = np.stack([C * (1j * self.w[:, None]) ** m for m in range(order + 1)])   # (m, line, channel)
         self.scale = float(np.abs(C).sum())
+        # exp(j w_k t) for the lines k = q B + r as exp(j w_qB t) exp(j w_r t): about 2 sqrt(lines)
+        # complex exponentials per call instead of one per line (the integrator calls this
+        # thousands of times), each product within a few rounding errors of the direct value
+        lines = C.shape[0]
+        self._block = max(1, int(np.sqrt(lines)))
+        self._w1 = 2 * np.pi * fs / n
+        self._outer = np.arange(-(-lines // self._block)) * self._block
+        self._inner = np.arange(self._block)
+        self._lines = lines
 
     def __call__(self, t):
         """(order + 1, channels) at the time t (s) from the first sample."""
-        return (np.exp(1j * self.w * t) @ self.D).real
+        e = (np.exp(1j * (self._w1 * t) * self._outer)[:, None] * np.exp(1j * (self._w1 * t) * self._inner)[None, :])
+        return (e.ravel()[:self._lines] @ self.D).real
 
 
 def _ct_rest_siso(model, u, fs, t0):
