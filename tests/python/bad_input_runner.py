@@ -158,6 +158,8 @@ def _cli_server(d):
     import traceback
 
     from lptv.apps import choose, cli, fileid, montecarlo  # noqa: F401 - imported before forking
+    # and what the commands import on first use (SciPy's submodules: 0.3-0.7 s in every child)
+    import scipy.fft, scipy.linalg, scipy.ndimage, scipy.signal, scipy.stats  # noqa: F401, E401
 
     os.chdir(d)
     for line in sys.stdin:
