@@ -138,12 +138,17 @@ consumer: cpp
 	./$(BUILDROOT)/consumer/lptv_consumer
 
 # The Python package into the venv; with the demo's packages only (make demo), the tests' and
-# benchmarks' targets add the rest (venv).
+# benchmarks' targets add the rest (venv). LPTV_INSTALLED=1 is make test's own: its second part
+# runs in a make of its own after the first has installed the package.
+ifeq ($(LPTV_INSTALLED),1)
+python:
+else
 python: deps-build venv-demo
 	@echo "building and installing the Python package lptv into $(VENV)/ (the C++ core and its module:" \
 	  "several minutes the first time, seconds once ccache holds them)"
 	PATH=$(CURDIR)/$(VENV)/bin:$$PATH CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PIP) install -q --disable-pip-version-check \
 	  --no-build-isolation --no-deps -Cbuild-dir=$(BUILDROOT)/py -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE_LAUNCH) .
+endif
 
 # pytest on PYTEST_WORKERS processes (pytest-xdist), each test file whole on one of them
 # (--dist loadfile: a module's fixtures are computed once and its tests run in their order; the
@@ -166,7 +171,11 @@ pytest: deps venv python
 bench-smoke: cpp venv python
 	$(PY) bench/smoke.py $(BUILD)/bench/cpp --out $(BUILDROOT)/bench-smoke --jobs $(JOBS)
 
-test: cpp-test consumer pytest bench-smoke wheel docs
+# The C++ tests, the consumer and pytest one after the other (pytest fills the cores), then the
+# benchmarks' smoke run, the wheel and the docs side by side (each mostly one core's work; each
+# target's output printed whole when it ends).
+test: cpp-test consumer pytest tools
+	$(MAKE) --no-print-directory -j $(JOBS) --output-sync=target LPTV_INSTALLED=1 bench-smoke wheel docs
 
 # The wheel: pip wheel on the build directory of make python (nothing is compiled again), then
 # auditwheel copies the shared libraries it links that are outside the manylinux policy
