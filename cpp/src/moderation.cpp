@@ -96,12 +96,16 @@ constexpr long long kShapeWidth = 2;
 // window holds the lines on one side only and the trend is extrapolated to i (its variance
 // enters v). Fewer than 2 W points in the window, or a singular fit: k = 1, v = 0. The
 // reference's _shape.
+// resid (optional): z[i] less the trend's value at i where ok[i] and at least W of the fitted
+// lines lie on either side, NaN elsewhere (the reference's _trend_residuals).
 void shape_factors(const Eigen::VectorXd& z, const std::vector<char>& ok, const std::vector<char>& keep,
-                   long long W, double var_log, Eigen::VectorXd& k, Eigen::VectorXd& v) {
+                   long long W, double var_log, Eigen::VectorXd& k, Eigen::VectorXd& v,
+                   Eigen::VectorXd* resid = nullptr) {
   const Eigen::Index m = z.size();
   const long long S = kShapeWidth * W;
   k = Eigen::VectorXd::Ones(m);
   v = Eigen::VectorXd::Zero(m);
+  if (resid) *resid = Eigen::VectorXd::Constant(m, std::numeric_limits<double>::quiet_NaN());
   std::vector<long long> left(m, 0), right(m, 0);
   for (long long x = 1; x <= S; ++x)
     for (Eigen::Index i = 0; i < m; ++i) {
@@ -128,6 +132,7 @@ void shape_factors(const Eigen::VectorXd& z, const std::vector<char>& ok, const 
     const Eigen::Matrix3d Ai = lu.inverse();
     if (!Ai.allFinite()) continue;
     const Eigen::Vector3d theta = Ai * Eigen::Vector3d(T[0], T[1], T[2]);
+    if (resid && ok[i] && left[i] >= W && right[i] >= W) (*resid)[i] = z[i] - theta[0];
     const Eigen::Matrix2d V = var_log * Ai.bottomRightCorner<2, 2>();
     double e_sum = 0.0, ex = 0.0, ex2 = 0.0;
     long long count = 0;
@@ -369,7 +374,8 @@ ModeratedNoise moderated_noise(const FrequencyData& data, int half_width) {
         }
       }
       if (count >= 3 * W) {
-        shape_factors(z, okv, keep, W, var_log, kch[c], vch[c]);
+        shape_factors(z, okv, keep, W, var_log, kch[c], vch[c],
+                      c == 0 ? &out.trend_residual_u : &out.trend_residual_y);
       } else {
         kch[c] = Eigen::VectorXd::Ones(m);
         vch[c] = Eigen::VectorXd::Zero(m);

@@ -10,6 +10,8 @@ void bind_moderation(py::module_& m) {
       .def_readonly("data", &lptv::ModeratedNoise::data)
       .def_readonly("dof", &lptv::ModeratedNoise::dof)
       .def_readonly("prior_dof", &lptv::ModeratedNoise::prior_dof)
+      .def_readonly("trend_residual_u", &lptv::ModeratedNoise::trend_residual_u)
+      .def_readonly("trend_residual_y", &lptv::ModeratedNoise::trend_residual_y)
       .def_readonly("outliers", &lptv::ModeratedNoise::outliers)
       .def_readonly("half_width", &lptv::ModeratedNoise::half_width)
       .def_readonly("moderated", &lptv::ModeratedNoise::moderated)

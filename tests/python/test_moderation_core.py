@@ -166,3 +166,32 @@ def test_core_rejects_what_the_wrapper_would():
     mod = lptv.moderated_noise(d)
     with pytest.raises(ValueError, match="lines"):
         mod.error_covariance([d.max_line + 1])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_core_s_trend_residuals_are_the_smoothness_check_s(seed):
+    """The residuals of the log variances about their local quadratic trend that the core's
+    moderation keeps (ModeratedNoise.trend_residual_u/_y, the fit behind its shape factors) against
+    the NumPy route of the smoothness check (_trend_residuals), on white and shaped noise with and
+    without outlying lines: the same lines left out (NaN), values within 1e-12 (log variances of
+    size <= 30, a 3 x 3 least-squares fit on offsets scaled to -1..1: about 1e-14 measured)."""
+    from lptv.spectra.moderation import _trend_residuals, moderated_noise
+
+    rng = np.random.default_rng(seed)
+    N = (256, 1000, 2048, 4096)[seed]
+    shape = 1 + 0.5 * np.sin(np.arange(N) / 40) if seed % 2 else 1.0
+    u = rng.standard_normal((8, N)) * shape
+    y = u + 0.1 * rng.standard_normal((8, N))
+    if seed >= 2:
+        y[:, ::17] *= 20          # narrowband lines: outliers of the moderation
+    mo = moderated_noise(lptv.FrequencyData.from_periods(u, y, w0=1.0))
+    keep = np.ones(mo.data.max_line - 1, bool)
+    if np.size(mo.outliers):
+        keep[np.asarray(mo.outliers) - 1] = False
+    for src, core in ((mo.source_varU, mo._core.trend_residual_u), (mo.source_varY, mo._core.trend_residual_y)):
+        r = _trend_residuals(np.asarray(src)[1:-1], keep, mo.half_width)
+        core = np.asarray(core)
+        assert core.shape == r.shape
+        assert np.array_equal(np.isnan(core), np.isnan(r))
+        assert np.isfinite(r).sum() > r.size // 2
+        np.testing.assert_allclose(core[np.isfinite(r)], r[np.isfinite(r)], rtol=0, atol=1e-12)

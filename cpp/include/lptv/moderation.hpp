@@ -30,6 +30,13 @@ struct ModeratedNoise {
   Eigen::Matrix<bool, Eigen::Dynamic, 1> neighbour;  // per line: may serve as a neighbour
   Eigen::VectorXd source_varU;   // the input's own variances the moderation started from
   Eigen::VectorXd source_varY;
+  // Per inner line 1..Lmax - 1 (index l - 1) of the input (output): its log variance less the
+  // value at l of the local log-quadratic trend fitted to the other lines over +-2 half_width
+  // (the fit the shape factors use); NaN where the line is outlying or zero, or fewer than
+  // half_width lines lie on either side. Empty where the channel has too few lines to fit.
+  // The smoothness check of noise='auto' reads the correlation of neighbours' residuals.
+  Eigen::VectorXd trend_residual_u;
+  Eigen::VectorXd trend_residual_y;
 
   // Covariance of the relative sampling errors of the moderated variances on `lines` (one
   // channel): each line's sample variance is off by a relative error of variance 1 / (P - 1),

@@ -241,13 +241,17 @@ def _lag_correlation(mo: ModeratedNoise):
         keep[np.asarray(mo.outliers, int) - 1] = False
     worst, pairs = -1.0, 0
     channels = mo.channel_variances if hasattr(mo, "channel_variances") else (mo.source_varU, mo.source_varY)
-    for v in channels:
+    # one channel's moderation in the core fitted the same trends for its shape factors
+    core = getattr(mo, "_core", None)
+    fitted = ((np.asarray(core.trend_residual_u), np.asarray(core.trend_residual_y))
+              if core is not None and hasattr(core, "trend_residual_u") else (None, None))
+    for c, v in enumerate(channels):
         if v is None:
             continue
         v = np.asarray(v, float)[1:-1]
         if np.count_nonzero(v > 0) < 3 * W:
             continue
-        r = _trend_residuals(v, keep, W)
+        r = fitted[c] if c < 2 and fitted[c] is not None and fitted[c].size == v.size else _trend_residuals(v, keep, W)
         a, b = r[:-1], r[1:]
         ok = np.isfinite(a) & np.isfinite(b)
         if ok.sum() < 3 * W:
