@@ -505,6 +505,12 @@ class ModeratedNoise:
     @property
     def source_varY(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         ...
+    @property
+    def trend_residual_u(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def trend_residual_y(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
 class ModeratedCovariances:
     """
     Covariance matrices of several channels moderated across neighbouring lines (lptv::moderated_covariances).
