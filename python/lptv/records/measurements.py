@@ -365,7 +365,31 @@ def _shape(a):
     return " x ".join(str(n) for n in a.shape)
 
 
+_CSV_PARSED: dict = {}
+"""The last CSV records parsed in this process, by path, names and content: `lptv identify FILE`
+reads its file twice (the inspection, then the fit), and the parse is most of a read."""
+
+
 def _read_csv(path, names):
+    """_parse_csv, or a copy of its result for a file of the same bytes read before."""
+    import dataclasses
+    import hashlib
+
+    size = path.stat().st_size
+    if 4 * size > memory_budget() or size > 2**24:
+        return _parse_csv(path, names)          # refused there, with the sizes; or not kept (16 MB of text)
+    key = (str(path.resolve()), size, hashlib.blake2b(path.read_bytes(), digest_size=16).digest(),
+           repr(names["u"]), repr(names["y"]), repr(names["time"]), bool(_INPUT_ONLY.get()))
+    raw = _CSV_PARSED.get(key)
+    if raw is None:
+        raw = _parse_csv(path, names)
+        _CSV_PARSED.clear()                     # one record kept: the one a command reads twice
+        _CSV_PARSED[key] = raw
+    return dataclasses.replace(raw, u=raw.u.copy(), y=raw.y.copy(),
+                               line_of=None if raw.line_of is None else list(raw.line_of))
+
+
+def _parse_csv(path, names):
     text = _csv_text(path)
     delimiter = _delimiter(text)
     rows = _Rows(text, delimiter)
