@@ -444,10 +444,15 @@ def _branches_panel(ax, res, sets, scale, n_points):
         ax.set_title("HTF branches of the model (the record does not separate them)", fontsize="medium")
         reason = ("excited lines closer than 2K + 1 apart" if any("apart" in m or "close" in m for m in why)
                   else "no entry of the data free of its neighbours' branches")
-        ax.text(0.02, 0.04, f"no nonparametric estimate: {reason}", transform=ax.transAxes, fontsize="small",
-                color="0.3")
+        # the note above the curves (a band of headroom) and the legend in the opposite corner,
+        # so that neither hides the other or a curve (the legend's 'best' place does not avoid a
+        # text; branches mostly fall with frequency)
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + 0.12 * (hi - lo))
+        ax.text(0.98, 0.97, f"no nonparametric estimate: {reason}", transform=ax.transAxes, fontsize="small",
+                color="0.3", ha="right", va="top")
     ax.set_ylabel("|G_k| (dB)")
-    ax.legend(fontsize="small", ncol=min(2 * K + 2, 4))
+    ax.legend(fontsize="small", ncol=min(2 * K + 2, 4), **({} if drawn else {"loc": "lower left"}))
 
 
 def inspection(insp, *, hz: bool = False, fig=None):
