@@ -52,8 +52,8 @@ Params make_params(const MimoStructure& st) {
   if (st.ny < 1 || st.nu < 1) throw std::invalid_argument("structure: ny and nu must be positive");
   if (st.ka.rows() < 1 || st.ka.cols() != st.ny || st.kb.rows() < 1 || st.kb.cols() != st.nu)
     throw std::invalid_argument("structure: ka must be (na+1) x ny and kb (nb+1) x nu");
-  if (st.ka.minCoeff() < 0 || st.kb.minCoeff() < 0)
-    throw std::invalid_argument("structure: harmonic counts must be non-negative");
+  if (st.ka.minCoeff() < 0 || st.kb.minCoeff() < -1)
+    throw std::invalid_argument("structure: harmonic counts must be non-negative (kb: -1 for an absent entry)");
   if (!(st.w0 > 0) || !std::isfinite(st.w0) || !(st.ts >= 0) || !std::isfinite(st.ts))
     throw std::invalid_argument("structure: w0 must be positive and ts non-negative");
   Params p;
@@ -83,7 +83,8 @@ Params make_params(const MimoStructure& st) {
   for (int n = 0; n <= p.na; ++n)
     for (int q = 0; q < p.ny; ++q) add(true, n, q, st.ka(n, q));
   for (int m = 0; m < st.kb.rows(); ++m)
-    for (int r = 0; r < p.nu; ++r) add(false, m, r, st.kb(m, r));
+    for (int r = 0; r < p.nu; ++r)
+      if (st.kb(m, r) >= 0) add(false, m, r, st.kb(m, r));  // -1: B_m has no entry in column r
   p.nphi = static_cast<int>(p.is_a.size());
   p.nrow = static_cast<int>(cols.size());
   p.T = MatrixXcd::Zero(p.nphi, p.nrow);

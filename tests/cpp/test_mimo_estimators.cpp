@@ -187,3 +187,25 @@ TEST_CASE("mimo_fit is WGTLS, SML and their covariances in one call", "[mimo_est
   REQUIRE((fs.residue_covariance.bottomRows(Ce.rows()) - Ce).cwiseAbs().maxCoeff() == 0.0);
   REQUIRE_THROWS_AS(lptv::mimo_fit(data, structure(), "ls", 1e-10, 50, true), std::invalid_argument);
 }
+
+TEST_CASE("an absent entry of B (kb = -1) is the structure without it", "[mimo_estimators]") {
+  // nb = 1 with every B_1 entry absent has exactly the parameters and rows of nb = 0: the same
+  // estimates, SML costs and covariances to rounding
+  const lptv::MimoModel m = two_by_two();
+  const auto data = experiments(m, 0.02, 5);
+  lptv::MimoStructure s0 = structure(), s1 = structure();
+  s1.kb = Eigen::MatrixXi::Zero(2, 2);
+  s1.kb.row(1).setConstant(-1);
+  REQUIRE(lptv::mimo_free_indices(s1) == lptv::mimo_free_indices(s0));
+  for (const std::string method : {"wgtls", "sml"}) {
+    const lptv::MimoFit f0 = lptv::mimo_fit(data, s0, method, 1e-10, 50, true);
+    const lptv::MimoFit f1 = lptv::mimo_fit(data, s1, method, 1e-10, 50, true);
+    REQUIRE((f0.estimate.xi - f1.estimate.xi).cwiseAbs().maxCoeff() <= 1e-12 * f0.estimate.xi.cwiseAbs().maxCoeff());
+    REQUIRE((f0.covariance - f1.covariance).cwiseAbs().maxCoeff() <= 1e-10 * f0.covariance.cwiseAbs().maxCoeff());
+  }
+  // one column's B_1 present, the other's absent: one real parameter more per output row
+  s1.kb(1, 0) = 0;
+  REQUIRE(lptv::mimo_free_indices(s1).size() == lptv::mimo_free_indices(s0).size() + 2);
+  s1.kb(1, 0) = -2;
+  REQUIRE_THROWS_AS(lptv::mimo_wgtls(data, s1, 1e-10, 10), std::invalid_argument);
+}

@@ -23,6 +23,8 @@ struct MimoSpectra {
 // Row-uniform structure: harmonic count per order and column, ka (na+1) x ny, kb (nb+1) x nu.
 // The real parameters xi stack the outputs' rows, each the coefficients (a, n, q) for
 // n = 0..na, q = 0..ny-1, then (b, m, r), each as Re c_0, Re c_1, Im c_1, .., Re c_K, Im c_K.
+// kb(m, r) = -1 leaves the entry (b, m, r) out (no parameters): the orders of B may differ from
+// column to column (the transient's noise-free columns of METHOD.md section 20 use it).
 struct MimoStructure {
   int ny = 1, nu = 1;
   Eigen::MatrixXi ka, kb;
