@@ -14,6 +14,7 @@ standardised errors, and for 'auto' how often it took the record's statistics an
 moderated them.
 
     python bench/python/bench_process_noise_mimo.py --runs 400 --periods 8 4 16 --loop open feedback
+    python bench/python/bench_process_noise_mimo.py --runs 400 --routes auto full-no-T --methods wgtls sml
     python bench/python/bench_process_noise_mimo.py --rows --runs 100 --periods 8 --loop feedback --process 0 5
 """
 from __future__ import annotations
@@ -32,23 +33,29 @@ import process_rig2 as pr  # noqa: E402  (tests/python/process_rig2.py: the 2 x 
 import lptv  # noqa: E402
 
 ROUTES = ("sample", "full", "auto")
+# a route's name: its noise= and transient= (METHOD.md section 20: the record's routes fit the
+# transient term by default; 'full-no-T' is the record's noise without it)
+ROUTE_ARGS = {"sample": ("sample", "auto"), "full": ("full", "auto"), "auto": ("auto", "auto"),
+              "full-no-T": ("full", False), "auto-no-T": ("auto", False)}
 
 
-def cell(loop, P, process, runs, methods, seed0):
+def cell(loop, P, process, runs, methods, seed0, routes=ROUTES):
     truth = pr.truth()
-    out = {(m, r): dict(rej=0, cov=[], z=[], full=0, moderated=0, n=0, failed=0) for m in methods for r in ROUTES}
+    out = {(m, r): dict(rej=0, cov=[], z=[], full=0, moderated=0, n=0, failed=0) for m in methods for r in routes}
     batch = 25
     for start in range(0, runs, batch):
         seeds = [seed0 + i for i in range(start, min(runs, start + batch))]
         for rec in pr.records(seeds, periods=P, loop=loop, process=process):
             for m in methods:
-                for route in ROUTES:
+                for route in routes:
                     o = out[(m, route)]
+                    noise, transient = ROUTE_ARGS[route]
                     try:
                         with warnings.catch_warnings():
                             warnings.simplefilter("ignore")
                             res = lptv.identify(rec["experiments"], **pr.STRUCTURE, w0=pr.W0,
-                                                lines=pr.fit_lines(), method=m, noise=route)
+                                                lines=pr.fit_lines(), method=m, noise=noise,
+                                                transient=transient)
                     except ValueError as err:      # counted and said, not hidden
                         o["failed"] += 1
                         print(f"#   {loop} P={P} {m} {route}: {err}", flush=True)
@@ -117,6 +124,8 @@ def main(argv=None) -> int:
                     help="each disturbance's rms in N (0: sensor noise alone)")
     ap.add_argument("--methods", nargs="+", default=["wgtls"], choices=["wgtls", "sml"])
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--routes", nargs="+", default=list(ROUTES), choices=list(ROUTE_ARGS),
+                    help="noise routes ('full-no-T', 'auto-no-T': without the record's transient term)")
     ap.add_argument("--rows", action="store_true",
                     help="only the residues at the true parameters (seeds from 2000 + seed): their variance "
                          "against eq. 19.12 on the record's statistics and their correlation between rows")
@@ -132,7 +141,7 @@ def main(argv=None) -> int:
         for loop in args.loop:
             for proc in args.process:
                 t0 = time.time()
-                out = cell(loop, P, proc, args.runs, args.methods, args.seed)
+                out = cell(loop, P, proc, args.runs, args.methods, args.seed, args.routes)
                 for (m, route), o in out.items():
                     n = o["n"]
                     cov = np.array(o["cov"])
@@ -145,7 +154,7 @@ def main(argv=None) -> int:
                     # record are not independent; this is the error if they were)
                     se_c = np.sqrt(pooled * (1 - pooled) / cov.size)
                     fail = f"  ({o['failed']} failed)" if o["failed"] else ""
-                    print(f"{loop:9s} {P:2d} {proc:5.1f}  {m:6s} {route:7s} {100 * rej:5.1f} (+-{100 * se:3.1f})  "
+                    print(f"{loop:9s} {P:2d} {proc:5.1f}  {m:6s} {route:9s} {100 * rej:5.1f} (+-{100 * se:3.1f})  "
                           f"{100 * pooled:5.1f} (+-{100 * se_c:3.1f})  [{100 * per.min():4.1f} {100 * per.max():5.1f}]  "
                           f"{np.abs(z.mean(0)).max():6.2f}  {z.std(0).min():4.2f}-{z.std(0).max():4.2f}   "
                           f"{o['full']}/{n} {o['moderated']}/{n}   {names[np.argmin(per)]}, {names[np.argmax(per)]}"

@@ -119,8 +119,9 @@ def test_the_default_keeps_the_true_structure_of_a_rig_with_a_disturbance(loop):
 
 
 def test_the_route_for_several_channels_and_one_agree():
-    """noise='full' on (P, N, 1) arrays is the one-channel fit on the record's per-line statistics
-    (several channels do not read the rows on the realisations yet)."""
+    """noise='full' on (P, N, 1) arrays without the record's transient term (transient=False) is
+    the one-channel fit on the record's per-line statistics (several channels do not read the
+    rows on the realisations yet); by default several channels fit the transient there."""
     rec = rig.records([3], periods=8, loop="feedback", process=5.0)[0]
     d = lptv.FrequencyData.from_periods(rec["u"], rec["y"], w0=rig.W0, statistics="record")
     with warnings.catch_warnings():
@@ -129,10 +130,11 @@ def test_the_route_for_several_channels_and_one_agree():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         many = lptv.identify(rec["u"][:, :, None], rec["y"][:, :, None], **rig.STRUCTURE, w0=rig.W0,
-                             lines=rig.fit_lines(), method="wgtls", noise="full")
+                             lines=rig.fit_lines(), method="wgtls", noise="full", transient=False)
         auto = lptv.identify(rec["u"][:, :, None], rec["y"][:, :, None], **rig.STRUCTURE, w0=rig.W0,
                              lines=rig.fit_lines(), method="wgtls")
     assert many.noise == "full" and auto.noise.startswith("full")
+    assert many.transient is None and auto.transient.shape == (1, 1, 2)
     np.testing.assert_allclose(many.eta, one.eta, rtol=1e-7, atol=1e-9 * np.abs(one.eta).max())
 
 

@@ -12,7 +12,7 @@ from ..spectra.frequency_data import FrequencyData, experiments_of, frequency_da
 from ..model.floquet import StabilityUndecidedWarning, UnstableModelWarning, stability_check
 from ..model.siso import Model
 from .._validate import INT_MAX, as_counts, as_float, as_int, as_lines
-from .mimo_identify import identify_mimo, is_mimo
+from .mimo_identify import as_transient, identify_mimo, is_mimo
 from ..judgement.result import IdentifiabilityWarning, IdentificationResult, _noise_alone, excited_rows  # noqa: F401 - their home was here
 
 METHODS = ("ls", "tls", "gtls", "wgtls", "sml")
@@ -101,7 +101,7 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
              kb: Union[int, Sequence[int]] = 0, w0: Optional[float] = None, ts: Optional[float] = None,
              lines=None, method: str = "wgtls", known: Optional[Mapping] = None, tol: float = 1e-10,
              max_iter: int = 50, covariance: str = "analytic", bootstrap: int = 200,
-             seed=None, noise: str = "auto", disturbances: Optional[str] = None):
+             seed=None, noise: str = "auto", disturbances: Optional[str] = None, transient="auto"):
     """Estimate an LPTV model from noisy input/output periods.
 
     Several inputs and outputs (METHOD.md section 19): ``u`` of shape (P, N, nu) and ``y`` of
@@ -206,6 +206,15 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         neighbouring lines (size 1 %), and 'sample' for ``covariance='bootstrap'`` or ``'realisations'`` and the
         realisations of :meth:`lptv.DistortionResult.experiments`. ``res.noise`` says which
         was used and ``res.noise_choice`` why. ``res.data`` holds the data the fit used.
+    transient : {'auto', True, False}
+        Several channels (3-D arrays): fit the record's transient term with the model (METHOD.md
+        section 20, eq. 20.5): per experiment and output, a polynomial in s (continuous time, powers
+        0 .. n - 1) or z (discrete time, powers 1 .. n), n = max(na, nb), with real coefficients,
+        which a disturbance that passes through the system leaves in every row of a record. 'auto'
+        (default): on the whole record's noise ('full', 'full-moderated', or 'auto' where it takes
+        them), off on the periods'. ``res.transient`` holds the coefficients. One input and one
+        output (2-D arrays): only 'auto' and False (the term is not fitted); True asks for arrays of
+        shape (P, N, 1).
     disturbances : {None, 'remove'}
         'remove': before the fit, find the sinusoids that are not periodic in the record (off
         the period's grid, such as mains hum beside a multisine whose period is not a multiple
@@ -264,7 +273,12 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
         if disturbances is not None:
             raise ValueError("disturbances: only disturbances=None is built for several inputs or outputs")
         return identify_mimo(u, y, na=na, nb=nb, ka=ka, kb=kb, w0=w0, ts=ts, lines=lines, method=method,
-                             known=known, tol=tol, max_iter=max_iter, covariance=covariance, noise=noise)
+                             known=known, tol=tol, max_iter=max_iter, covariance=covariance, noise=noise,
+                             transient=transient)
+    if as_transient(transient) is True:
+        raise ValueError("transient=True is built for the route of several channels: give one input and one output "
+                         "as arrays of shape (P, N, 1) to fit the record's transient term (METHOD.md section 20 says "
+                         "why one channel's route does not take it by default)")
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if not isinstance(covariance, str) or covariance not in COVARIANCES:

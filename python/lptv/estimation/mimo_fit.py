@@ -99,3 +99,65 @@ def expand(cov_free: np.ndarray, st: MimoStructure) -> np.ndarray:
     f = st.free
     out[np.ix_(f, f)] = cov_free
     return out
+
+
+def transient_orders(st: MimoStructure) -> np.ndarray:
+    """The powers of the record's transient term (METHOD.md section 20, eq. 20.5): s^0 .. s^(n-1)
+    in continuous time, z^1 .. z^n in discrete time, n = max(na, nb)."""
+    n = max(st.na, st.nb)
+    return np.arange(1, n + 1) if st.ts else np.arange(n)
+
+
+class Transient:
+    """The fit with the record's transient term of each experiment and output (METHOD.md section
+    20, "The record's transient in the fit"): the experiments' spectra with one noise-free input
+    more per experiment, 1 on every line of its own experiment and 0 in the others, whose B
+    entries (no harmonics) at the transient's powers are its real coefficients; every other
+    input keeps its own orders (the absent entries kb = -1 of the core's structure)."""
+
+    def __init__(self, st: MimoStructure, n_experiments: int):
+        self.orders = transient_orders(st)
+        self.n_experiments = E = int(n_experiments)
+        nb = max(st.nb, int(self.orders.max()))
+        kb = -np.ones((nb + 1, st.nu + E), dtype=int)
+        kb[:st.nb + 1, :st.nu] = st.kb
+        kb[np.ix_(self.orders, np.arange(st.nu, st.nu + E))] = 0
+        self.base = st
+        self.st = MimoStructure(st.na, nb, st.ka, kb, st.ny, st.nu + E, st.w0, st.ts or None)
+        pos = {n: i for i, n in enumerate(self.st.names)}
+        self.keep = np.array([pos[n] for n in st.names])
+        self.nuisance = np.array([[[pos[f"b{m}[{p},{st.nu + e}].re0"] for m in self.orders] for p in range(st.ny)]
+                                  for e in range(E)])
+        fpos = {int(i): k for k, i in enumerate(self.st.free)}
+        self.free_keep = np.array([fpos[int(i)] for i in self.keep[st.free]])
+
+    @property
+    def n_parameters(self) -> int:
+        """The real coefficients the transient adds: experiments x outputs x powers."""
+        return int(self.nuisance.size)
+
+    def data(self, datas: Sequence[MimoFrequencyData], rows_list) -> List[tuple]:
+        """The core's spectra with the transient's inputs (noise-free: zero (co)variances)."""
+        out = []
+        E = self.n_experiments
+        for e, (Y, U, C, rows) in enumerate(core_data(datas, rows_list)):
+            L1, nu = U.shape
+            ny = Y.shape[1]
+            c = ny + nu
+            Ua = np.zeros((L1, nu + E), complex)
+            Ua[:, :nu] = U
+            Ua[:, nu + e] = 1.0
+            Ca = np.zeros((L1, c + E, c + E), complex)
+            Ca[:, :c, :c] = C.reshape(L1, c, c)
+            out.append((Y, Ua, Ca.reshape(-1, c + E), rows))
+        return out
+
+    def structure(self):
+        return core_structure(self.st)
+
+    def reduce(self, xi_aug: np.ndarray, free_cov_aug: np.ndarray = None):
+        """The model's xi and its free covariance (the transient's coefficients profiled out: the
+        block of the joint covariance), and the coefficients (experiments, outputs, powers)."""
+        xi = np.asarray(xi_aug)[self.keep]
+        cov = None if free_cov_aug is None else free_cov_aug[np.ix_(self.free_keep, self.free_keep)]
+        return xi, cov, np.asarray(xi_aug)[self.nuisance]

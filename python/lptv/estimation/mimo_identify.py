@@ -13,7 +13,7 @@ from .._validate import _array, as_float, as_int, as_lines, check_finite
 from ..model.mimo import MimoModel
 from ..spectra.frequency_data import refuse_repeated_experiments
 from ..spectra.mimo_frequency_data import MimoFrequencyData, MimoStructure, as_entry_counts, as_order
-from .mimo_fit import FitError, core_data, core_structure, expand, fisher, fit, residues
+from .mimo_fit import FitError, Transient, core_data, core_structure, expand, fisher, fit, residues, transient_orders
 from ..judgement.mimo_result import MimoIdentificationResult, residue_tests
 
 MIMO_METHODS = ("gtls", "wgtls", "sml")
@@ -228,7 +228,7 @@ def _known_leading(known, na, ny):
 
 def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None, method="wgtls",
                   known=None, tol=1e-10, max_iter=50, covariance="analytic",
-                  noise="auto") -> MimoIdentificationResult:
+                  noise="auto", transient="auto") -> MimoIdentificationResult:
     """lptv.identify's route for several inputs or outputs (its docstring has the arguments)."""
     noises = ("auto", "sample", "moderated", "full", "full-moderated")
     if noise == "full-rows":
@@ -240,6 +240,7 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         raise ValueError(f"method must be one of {MIMO_METHODS} for several inputs or outputs, got {method!r}")
     if not isinstance(covariance, str) or covariance not in ("analytic", "none"):
         raise ValueError(f"covariance must be 'analytic' or 'none' for several inputs or outputs, got {covariance!r}")
+    transient = as_transient(transient)
     na, nb = as_order(na, "na"), as_order(nb, "nb")
     tol = as_float(tol, "tol", minimum=0.0, open_min=True)
     max_iter = as_int(max_iter, "max_iter", minimum=1)
@@ -259,6 +260,13 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     else:
         per = [lines] * len(datas)
     rows_list = [_rows_of(d, v, st.K, e) for e, (d, v) in enumerate(zip(datas, per))]
+    # the record's transient term (METHOD.md section 20, eq. 20.5): fitted on the record's
+    # statistics, where a disturbance that passes through the system was found or asked for
+    if transient is True and transient_orders(st).size == 0:
+        raise ValueError("transient: na = nb = 0 has no transient term (a static system's record holds none)")
+    tr = Transient(st, len(datas)) if (transient is True or (transient == "auto" and route.startswith("full")
+                                                              and transient_orders(st).size)) else None
+    n_tr = 0 if tr is None else tr.n_parameters
     low = [int(r[r <= st.K][0]) for r in rows_list if np.any(r <= st.K)]
     if low and method == "sml" and noise_route_noisy(datas):
         raise ValueError(f"lines: line {low[0]} is a row l <= K = {st.K}, which reads line 0 and the conjugates of "
@@ -266,8 +274,9 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
                          "by the circular complex likelihood, which such rows do not have: give rows from "
                          f"{st.K + 1}, or use method='wgtls' (its residue covariance and sandwich take them)")
     n_eq = sum(2 * r.size * ny for r in rows_list)
-    if n_eq < st.free.size:
-        raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters")
+    if n_eq < st.free.size + n_tr:
+        raise ValueError(f"lines: {n_eq // 2} complex residues cannot determine {st.free.size} free real parameters"
+                         + (f" and the {n_tr} of the record's transient" if n_tr else ""))
     P = np.array([d.periods for d in datas])
     noisy = noise_route_noisy(datas)
     # the periods the (co)variances are worth: P, or 1 + dof / 2 of the moderated ones (the
@@ -277,13 +286,19 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
     if noisy and ny > 1 and P.min() <= ny:
         raise ValueError(f"u, y: P = {int(P.min())} periods give residue covariances of rank at most P - 1 < ny = "
                          f"{ny} (complex Wishart, METHOD.md section 19): several outputs need P > ny periods")
-    data, cst = core_data(datas, rows_list), core_structure(st)
+    if tr is None:
+        data, cst = core_data(datas, rows_list), core_structure(st)
+    else:
+        data, cst = tr.data(datas, rows_list), tr.structure()
     warns = []
     try:
         xi, iters, converged, sv, noise_free, cost_sml, free_cov, res, Ce = fit(
             data, cst, method, tol=tol, max_iter=max_iter, covariance=covariance == "analytic")
     except FitError as err:
         raise ValueError(f"u, y: {err}") from None
+    xi_core, t_coef = xi, None
+    if tr is not None:
+        xi, free_cov, t_coef = tr.reduce(xi, free_cov)
     if noisy:
         warns += silent_outputs(datas, rows_list)
     d = ny * ny
@@ -317,6 +332,9 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         xi = xi.copy()
         xi[fixed] = np.round(xi[fixed])
     xi_fit = xi
+    if tr is not None:
+        xi_fit = xi_core.copy()
+        xi_fit[tr.keep] = xi
     if lead is not None:
         # the model with A_na,0 = M is M times the one with A_na,0 = I (the same system)
         Kx = np.kron(lead, np.eye(st.n_row))
@@ -335,7 +353,8 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
         # the verdict divides by the moderated covariances with the prior's part at the
         # neighbours' mean itself (section 7, "The verdict's scale"), each row worth its line's dof
         row_P = np.concatenate([m.periods[r] for r, m in zip(rows_list, mos)])
-        _, Cv = residues(core_data([m.unbiased_data() for m in mos], rows_list), cst, xi_fit)
+        unbiased = [m.unbiased_data() for m in mos]
+        _, Cv = residues(core_data(unbiased, rows_list) if tr is None else tr.data(unbiased, rows_list), cst, xi_fit)
         if lead is not None:
             Cv = np.einsum("pi,rij,qj->rpq", lead, Cv, lead)
     # rows l <= K read line 0 or a conjugate line: residues that are not circular, which the F
@@ -351,7 +370,17 @@ def identify_mimo(u, y=None, *, na, nb, ka=0, kb=0, w0=None, ts=None, lines=None
             [np.full(r.size, e) for e, r in enumerate(rows_list)]), residue=res, residue_covariance=Ce,
         periods=tuple(int(p) for p in P), iterations=int(iters), singular_values=np.asarray(sv),
         n_free_parameters=int(st.free.size), noise_free=bool(noise_free), covariance_factor=float(factor),
-        warnings=tuple(warns), tests=tests, noise=route, noise_choice=choice, moderation=tuple(mos or ()))
+        warnings=tuple(warns), tests=tests, noise=route, noise_choice=choice, moderation=tuple(mos or ()),
+        transient=t_coef, transient_powers=None if tr is None else tuple(int(m) for m in tr.orders))
+
+
+def as_transient(transient):
+    """'auto', True or False (``transient=`` of :func:`lptv.identify`), else a ValueError."""
+    if isinstance(transient, (bool, np.bool_)):
+        return bool(transient)
+    if isinstance(transient, str) and transient == "auto":
+        return "auto"
+    raise ValueError(f"transient must be 'auto', True or False, got {transient!r}")
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,24 @@ class MimoIdentificationResult:
     """Why: 'asked for', or the smoothness check's sentence for noise='auto'."""
     moderation: Tuple = field(default=(), repr=False)
     """The :class:`lptv.mimo_moderation.MimoModeratedNoise` of each experiment (moderated route)."""
+    transient: Optional[np.ndarray] = field(default=None, repr=False)
+    """The record's transient term fitted with the model (METHOD.md section 20, eq. 20.5), its
+    real coefficients c[e, p, j] of experiment e, output p and power ``transient_powers[j]`` of
+    s (continuous time) or z (discrete time); None when the fit had none (``transient=False``,
+    or 'auto' on the periods' statistics)."""
+    transient_powers: Optional[Tuple[int, ...]] = None
+    """The powers of s or z of :attr:`transient`'s last axis."""
+
+    @property
+    def transient_note(self) -> str:
+        """One sentence on the transient term: fitted (how many coefficients) or not."""
+        if self.transient is None:
+            return "the record's transient term: not fitted"
+        E, ny, n = self.transient.shape
+        var = "z" if self.model.ts else "s"
+        pw = ", ".join(f"{var}^{m}" for m in self.transient_powers)
+        return (f"the record's transient term fitted ({pw}; {E * ny * n} real coefficients, "
+                f"per output and experiment: METHOD.md section 20)")
 
     @property
     def n_inputs(self) -> int:
@@ -216,6 +234,8 @@ class MimoIdentificationResult:
             lines.append(f"noise (co)variances: {self.noise} (asked for)")
         else:
             lines.append(f"noise (co)variances (noise='auto'): {self.noise_choice}")
+        if self.transient is not None:
+            lines.append(self.transient_note)
         if self.covariance is None:
             head = (" (no covariance: noise-free data)" if self.noise_free else
                     " (no covariance: covariance='none' or method 'gtls')")

@@ -29,7 +29,8 @@ __all__ = ["Structure", "residue_map", "residue", "jacobian", "line_covariances"
 
 
 class Structure:
-    """na, nb, ka (na+1, ny) and kb (nb+1, nu) per order and column, w0, ts; the parameter list."""
+    """na, nb, ka (na+1, ny) and kb (nb+1, nu) per order and column (kb = -1: no entry), w0, ts;
+    the parameter list."""
 
     def __init__(self, na, nb, ka, kb, w0, ts=None):
         self.ka, self.kb = np.atleast_2d(np.asarray(ka, int)), np.atleast_2d(np.asarray(kb, int))
@@ -37,7 +38,8 @@ class Structure:
         self.ny, self.nu = self.ka.shape[1], self.kb.shape[1]
         self.w0, self.ts = float(w0), float(ts or 0.0)
         self.coefs = [("a", n, q, self.ka[n, q]) for n in range(self.na + 1) for q in range(self.ny)] + \
-                     [("b", m, r, self.kb[m, r]) for m in range(self.nb + 1) for r in range(self.nu)]
+                     [("b", m, r, self.kb[m, r]) for m in range(self.nb + 1) for r in range(self.nu)
+                      if self.kb[m, r] >= 0]   # kb = -1: the entry absent
         self.row = sum(2 * K + 1 for *_, K in self.coefs)
         self.K = int(max(self.ka.max(), self.kb.max()))
         fixed = []

@@ -153,7 +153,8 @@ class MimoStructure:
         self.ts = float(ts) if ts else 0.0
         self.coefs: List[Tuple[bool, int, int, int]] = (
             [(True, n, q, int(self.ka[n, q])) for n in range(self.na + 1) for q in range(self.ny)]
-            + [(False, m, r, int(self.kb[m, r])) for m in range(self.nb + 1) for r in range(self.nu)])
+            + [(False, m, r, int(self.kb[m, r])) for m in range(self.nb + 1) for r in range(self.nu)
+               if self.kb[m, r] >= 0])     # kb = -1: an absent entry (the transient's columns, section 20)
         is_a, order, col, harm, cols, names = [], [], [], [], [], []
         fixed = []
         for ci, (a, n, c, K) in enumerate(self.coefs):
