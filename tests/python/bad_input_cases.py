@@ -632,6 +632,8 @@ def python_cases():
         Case("identify-y-missing", "type", lambda: lp().identify(U(), na=1, nb=0, w0=0.1), match=names("y")),
         Case("identify-w0-missing", "type", lambda: lp().identify(U(), Y(), na=1, nb=0), match=names("w0")),
         Case("identify-ka-list-length", "shape", lambda: ident(ka=[1, 2, 3]), match=names("ka")),
+        Case("identify-transient-bogus", "value", lambda: ident(transient="yes"), match=names("transient")),
+        Case("identify-transient-one-channel", "value", lambda: ident(transient=True), match=names("transient")),
         Case("identify-ka-list-2**31", "overflow", lambda: ident(ka=[2**31, 0]), match=with_value("ka", 2**31)),
         Case("identify-ka-list-nan", "nan/inf", lambda: ident(ka=[NaN, 0]), match=names("ka")),
         Case("identify-data-w0-disagrees", "value", lambda: lp().identify(data(), na=1, nb=0, w0=0.2),
@@ -1169,6 +1171,8 @@ def cli_cases():
     add("identify-covariance-bogus", ok + ("--covariance", "jackknife"), "--covariance")
     add("identify-noise-bogus", ok + ("--noise", "smooth"), "--noise")
     add("identify-referred-bogus", ok + ("--referred", "inside"), "--referred")
+    add("identify-transient-bogus", ok + ("--transient", "yes"), "--transient")
+    add("identify-transient-on-one-channel", ok + ("--transient", "on"), "--transient on is built for several channels")
     for v in ("5", "abc") + big:
         add(f"identify-bootstrap-{v}", ok + ("--bootstrap", v), "--bootstrap")
     add("identify-out-proc", ok + ("--out", "/proc/nope"), "/proc/nope")

@@ -333,3 +333,25 @@ def test_a_wrong_period_is_named_by_the_record_not_blamed_on_the_fit(files, caps
     assert f"use --period {T0:.12g}" in err
     rc, out, err = identify_cli(capsys, *files, *base, "--period", 4 * T0, "--no-period-check")
     assert rc == 2 and "several outputs need P > ny periods" in err
+
+
+@needs_fit
+def test_transient_option_gives_the_api_fit_and_says_it(experiments, files, tmp_path, capsys):
+    """--transient on fits the record's transient term as lptv.identify(..., transient=True) does,
+    prints and writes it; --transient off and the default on the periods' noise do not; one
+    input and one output refuse --transient on with the reason."""
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--noise", "full", "--transient", "on", "--out", tmp_path / "o")
+    assert rc in (0, 3), out + err
+    res = lptv.identify(experiments, na=2, nb=0, ka=[1, 0, 0], kb=0, w0=W0, noise="full", transient=True)
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["transient"]["powers"] == [0, 1] and summary["transient"]["variable"] == "s"
+    np.testing.assert_allclose(summary["transient"]["coefficients"], res.transient, rtol=1e-9,
+                               atol=1e-12 * np.abs(res.transient).max())
+    assert "the record's transient term fitted (s^0, s^1; 8 real coefficients" in out
+    assert "transient term fitted" in (tmp_path / "o" / "report.html").read_text()
+    rc, out, err = identify_cli(capsys, *files, *FIT, "--noise", "full", "--transient", "off", "--out", tmp_path / "p")
+    assert json.loads((tmp_path / "p" / "summary.json").read_text())["transient"] is None
+    assert "transient term fitted" not in out
+    rc, out, err = identify_cli(capsys, files[0], "--input", "f1", "--output", "x1", "--period", T0, "--na", "2",
+                                "--nb", "0", "--transient", "on")
+    assert rc == 2 and "--transient on is built for several channels" in err

@@ -191,7 +191,7 @@ def test_bad_values_are_refused_naming_the_argument():
         with pytest.raises(ValueError, match="transient must be 'auto', True or False"):
             lptv.identify(pairs, transient=bad, **kw)
     u, y = pairs[0][0][..., 0], pairs[0][1][..., 0]
-    with pytest.raises(ValueError, match=r"transient=True is built for the route of several channels.*\(P, N, 1\)"):
+    with pytest.raises(ValueError, match=r"transient=True is not built for one input and one output.*\(P, N, 1\)"):
         lptv.identify(u, y, na=2, nb=0, w0=mx.W0, transient=True)
     with pytest.raises(ValueError, match="transient: na = nb = 0"):
         lptv.identify(pairs, na=0, nb=0, w0=mx.W0, lines=np.arange(2, 16), transient=True)

@@ -129,6 +129,11 @@ def add_parser(sub):
                    "realisations; auto (default): the record's when the periods' noise is "
                    "correlated between neighbouring lines, moderated when the noise spectrum passes a "
                    "smoothness check; the summary says which and why")
+    p.add_argument("--transient", default="auto", choices=("auto", "on", "off"),
+                   help="several channels: fit the record's transient term (a real polynomial in s or z per output "
+                   "and experiment, which a disturbance that passes through the system leaves in every row): "
+                   "auto (default) on the whole record's noise, on, off (METHOD.md section 20); one input and "
+                   "output: auto or off")
     p.add_argument("--referred", default="auto", choices=("auto", "output", "input", "none"),
                    help="a record of M x P x N realisations: the nonlinear distortion weighed as output noise "
                    "(output: a nonlinearity after the dynamics), referred to the input through a first fit "
@@ -207,6 +212,11 @@ def run(args) -> int:
     if args.resume and (args.joint or (len(args.files) == 1 and args.workers is None and args.scheduler is None)):
         print("lptv identify: error: --resume applies to a batch of files (several files, --workers or "
               "--scheduler), not to one record or --joint", file=sys.stderr)
+        return 2
+    if getattr(args, "transient", "auto") == "on":
+        print("lptv identify: error: --transient on is built for several channels (--input f1,f2 or --output x1,x2); "
+              "one input and one output fit without the record's transient term (METHOD.md section 20 says why)",
+              file=sys.stderr)
         return 2
     if getattr(args, "input_noise", None) is not None and not getattr(args, "one_record", False):
         print("lptv identify: error: --input-noise is for --one-record (records of periods measure the input's "

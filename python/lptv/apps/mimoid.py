@@ -174,7 +174,8 @@ def run(args) -> int:
             warnings.simplefilter("always")
             res = lptv.identify(experiments, na=args.na, nb=args.nb, ka=ka, kb=kb, w0=w0, ts=ts,
                                 lines=lines, method=args.method, tol=args.tol, max_iter=args.max_iter,
-                                noise=getattr(args, "noise", None) or "auto")
+                                noise=getattr(args, "noise", None) or "auto",
+                                transient={"on": True, "off": False}.get(getattr(args, "transient", "auto"), "auto"))
     except NumericalError as e:
         return _fail(in_option_terms(_named(e, files), OPTION_NAMES), status=1)
     except ValueError as e:
@@ -296,6 +297,9 @@ def json_summary(args, records, w0, ts, ka, kb, res, notes) -> dict:
         "n_inputs": res.model.n_inputs, "n_outputs": res.model.n_outputs,
         "w0": w0, "ts": ts, "na": res.model.na, "nb": res.model.nb, "ka": ka, "kb": kb,
         "method": res.method, "noise": getattr(res, "noise", "sample"), "noise_choice": getattr(res, "noise_choice", ""),
+        "transient": None if getattr(res, "transient", None) is None else {
+            "powers": list(res.transient_powers), "variable": "z" if res.model.ts else "s",
+            "coefficients": np.asarray(res.transient).tolist(), "note": res.transient_note},
         "n_rows": int(res.lines.size), "converged": bool(res.converged),
         "cost": float(res.cost),
         "parameters": [dict(r, unit=unit_of.get(r["name"].split(".")[0], "")) for r in res.parameters(0.95)],

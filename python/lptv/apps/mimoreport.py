@@ -72,6 +72,10 @@ def build(res, *, files, inputs, outputs, w0, stability, physical=None, experime
     choice = getattr(res, "noise_choice", "")
     rep.paragraph(f"Noise (co)variances: {route} (asked for)." if choice in ("", "asked for") else
                   f"Noise (co)variances (noise='auto'): {choice}.")
+    if getattr(res, "transient", None) is not None:
+        rep.paragraph(res.transient_note[0].upper() + res.transient_note[1:] + ": a disturbance that passes through "
+                      "the system leaves the record's boundary states in every row, a term the rows then do not "
+                      "share as noise.")
     u_units = [units.channel_unit(n) for n in inputs]
     y_units = [units.channel_unit(n) for n in outputs]
     rep.heading("Parameters")

@@ -278,7 +278,7 @@ def fundamental(args, meas):
 
 OPTION_NAMES = {"na": "--na", "nb": "--nb", "ka": "--ka", "kb": "--kb", "max_iter": "--max-iter",
                 "tol": "--tol", "lines": "--lines", "known": "--known", "method": "--method", "w0": "--w0",
-                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap", "noise": "--noise",
+                "ts": "--ts", "periods": "--periods", "covariance": "--covariance", "bootstrap": "--bootstrap", "noise": "--noise", "transient": "--transient",
                 "disturbances": "--remove-disturbances"}
 """The arguments of lptv.identify and the options that set them, for the messages."""
 

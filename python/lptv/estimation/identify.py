@@ -276,9 +276,9 @@ def identify(u, y=None, *, na: int, nb: int, ka: Union[int, Sequence[int]] = 0,
                              known=known, tol=tol, max_iter=max_iter, covariance=covariance, noise=noise,
                              transient=transient)
     if as_transient(transient) is True:
-        raise ValueError("transient=True is built for the route of several channels: give one input and one output "
-                         "as arrays of shape (P, N, 1) to fit the record's transient term (METHOD.md section 20 says "
-                         "why one channel's route does not take it by default)")
+        raise ValueError("transient=True is not built for one input and one output given as 2-D arrays: give them "
+                         "as arrays of shape (P, N, 1) (the route of several channels) to fit the record's transient "
+                         "term (METHOD.md section 20 says why one channel's route does not take it by default)")
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if not isinstance(covariance, str) or covariance not in COVARIANCES:
