@@ -112,25 +112,46 @@ void shape_factors(const Eigen::VectorXd& z, const std::vector<char>& ok, const 
       if (i - x >= 0 && ok[i - x]) ++left[i];
       if (i + x < m && ok[i + x]) ++right[i];
     }
+  // The window's moments C and their inverse depend only on which of its lines are ok: where
+  // every line of the window is (the interior of a clean spectrum) they are the same from one
+  // line to the next, and the previous line's are reused (the same sums in the same order, so the
+  // same bits as computing them again).
+  bool have_full = false, full_invertible = false;
+  Eigen::Matrix3d full_inverse;
   for (Eigen::Index i = 0; i < m; ++i) {
     if (left[i] + right[i] < 2 * W) continue;
-    double C[5] = {0, 0, 0, 0, 0}, T[3] = {0, 0, 0};
+    const bool full = left[i] == S && right[i] == S;
+    double T[3] = {0, 0, 0};
     for (long long x = -S; x <= S; ++x) {
       const long long j = i + x;
       if (x == 0 || j < 0 || j >= m || !ok[j]) continue;
       const double xf = static_cast<double>(x);
-      double p = 1.0;
-      for (int q = 0; q < 5; ++q, p *= xf) {
-        C[q] += p;
-        if (q < 3) T[q] += z[j] * p;
-      }
+      T[0] += z[j];
+      T[1] += z[j] * xf;
+      T[2] += z[j] * (xf * xf);
     }
-    Eigen::Matrix3d A;
-    A << C[0], C[1], C[2], C[1], C[2], C[3], C[2], C[3], C[4];
-    const Eigen::FullPivLU<Eigen::Matrix3d> lu(A);
-    if (!lu.isInvertible()) continue;
-    const Eigen::Matrix3d Ai = lu.inverse();
-    if (!Ai.allFinite()) continue;
+    Eigen::Matrix3d Ai;
+    if (full && have_full) {
+      if (!full_invertible) continue;
+      Ai = full_inverse;
+    } else {
+      double C[5] = {0, 0, 0, 0, 0};
+      for (long long x = -S; x <= S; ++x) {
+        const long long j = i + x;
+        if (x == 0 || j < 0 || j >= m || !ok[j]) continue;
+        const double xf = static_cast<double>(x);
+        double p = 1.0;
+        for (int q = 0; q < 5; ++q, p *= xf) C[q] += p;
+      }
+      Eigen::Matrix3d A;
+      A << C[0], C[1], C[2], C[1], C[2], C[3], C[2], C[3], C[4];
+      const Eigen::FullPivLU<Eigen::Matrix3d> lu(A);
+      const bool invertible = lu.isInvertible();
+      if (invertible) Ai = lu.inverse();
+      const bool usable = invertible && Ai.allFinite();
+      if (full) have_full = true, full_invertible = usable, full_inverse = Ai;
+      if (!usable) continue;
+    }
     const Eigen::Vector3d theta = Ai * Eigen::Vector3d(T[0], T[1], T[2]);
     if (resid && ok[i] && left[i] >= W && right[i] >= W) (*resid)[i] = z[i] - theta[0];
     const Eigen::Matrix2d V = var_log * Ai.bottomRightCorner<2, 2>();
