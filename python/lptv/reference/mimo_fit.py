@@ -7,9 +7,10 @@ here) but none of the code: the residue is e = G(xi) z with G built entry by ent
 row, output, line and channel; the Jacobian's column j is G(e_j) z; the noise of every row is
 G Cz G^H over the whole stacked noise vector; CJ_W is tr(W G_j' Cz G_j^H) for every pair of
 parameters; WGTLS is a generalised symmetric eigenproblem (scipy.linalg.eigh) of the tall real
-Jacobian's Gram matrix and CJ_W, not a QR, Cholesky and SVD; SML minimises the cost with SciPy's
-BFGS and the gradient 2 Re(e_j^H w) - w^H dC_j w (dC_j the derivative of the covariance), not
-the production's denoised-spectra route.
+Jacobian's Gram matrix and CJ_W, not a QR, Cholesky and SVD; SML minimises the cost by
+Gauss-Newton steps on the gradient 2 Re(e_j^H w) - w^H dC_j w (dC_j the derivative of the
+covariance) with the dense Fisher information as the Hessian, not the production's
+denoised-spectra route.
 
 Conventions (shared): spectra on lines 0..L (``fft(x)[l] / N``); C[l] the covariance of the
 mean of [Y_l; U_l] (outputs first); xi stacks each output's row of real parameters, a row being
@@ -22,7 +23,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg
-import scipy.optimize
 
 __all__ = ["Structure", "residue_map", "residue", "jacobian", "line_covariances", "row_covariance",
            "wgtls", "sml", "fisher", "sandwich", "crb"]
@@ -181,7 +181,7 @@ def _cost_grad(st, xi, experiments):
         CE = G @ Cz @ G.conj().T
         w = np.linalg.solve(CE, e)
         V += float(np.real(np.vdot(e, w)))
-        for j in range(n):
+        for j in st.free:       # the gradient over the free entries (0 at the fixed ones)
             Gj = residue_map(st, np.eye(n)[j], rows, Y.shape[0])
             dC = Gj @ Cz @ G.conj().T
             dC = dC + dC.conj().T
@@ -189,22 +189,36 @@ def _cost_grad(st, xi, experiments):
     return V, g
 
 
-def sml(st, experiments, xi0, gtol=1e-10):
-    """Minimise sum e^H C_E^-1 e over the free entries of xi by BFGS from xi0."""
-    free = st.free
-    scale = np.where(np.abs(xi0[free]) > 0, np.abs(xi0[free]), 1.0)
-
-    def f(x):
-        xi = np.array(xi0, float)
-        xi[free] = x * scale
-        V, g = _cost_grad(st, xi, experiments)
-        return V, g[free] * scale
-
-    out = scipy.optimize.minimize(f, np.asarray(xi0)[free] / scale, jac=True, method="BFGS",
-                                  options=dict(gtol=gtol, maxiter=2000))
+def sml(st, experiments, xi0, tol=1e-8, max_iter=50):
+    """Minimise sum e^H C_E^-1 e over the free entries of xi from xi0 by Gauss-Newton: the step
+    F^-1 g with F the reference's own Fisher information (:func:`fisher`, the cost's Hessian to
+    first order) and g the cost's exact gradient (:func:`_cost_grad`, C_E's dependence on xi
+    included), halved until the cost does not rise. Stops when the step is below ``tol`` of every
+    free entry's standard deviation sqrt((F^-1)_jj), or when no halving lowers the cost (a minimum
+    to rounding). The minimum is the cost's, whatever the route to it: the production's
+    Levenberg-Marquardt on the whitened band is a different computation of the same optimum.
+    Returns (xi, info) with info's 'iterations' and 'converged'."""
+    free = np.asarray(st.free)
     xi = np.array(xi0, float)
-    xi[free] = out.x * scale
-    return xi, out
+    V, g = _cost_grad(st, xi, experiments)
+    for it in range(1, max_iter + 1):
+        F = fisher(st, xi, experiments)
+        step = np.linalg.solve(F, g[free])
+        std = np.sqrt(np.diag(np.linalg.inv(F)))
+        t = 1.0
+        while t >= 1e-10:
+            xn = xi.copy()
+            xn[free] -= t * step
+            Vn, gn = _cost_grad(st, xn, experiments)
+            if Vn <= V:
+                break
+            t /= 2
+        else:
+            return xi, dict(iterations=it, converged=True)      # no step lowers the cost
+        xi, V, g = xn, Vn, gn
+        if np.max(np.abs(t * step) / std) < tol:
+            return xi, dict(iterations=it, converged=True)
+    return xi, dict(iterations=max_iter, converged=False)
 
 
 def _denoised_jacobian(st, xi, Y, U, C, rows):
