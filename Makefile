@@ -63,7 +63,7 @@ export CXX
 CCACHE_LAUNCH = $(if $(shell command -v ccache),ccache,)
 
 .PHONY: test demo bench bench-smoke deps deps-build deps-bench venv venv-demo cpp cpp-test consumer python \
-	pytest stubs clean sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
+	pytest pytest-order stubs clean sanitize sanitize-build sanitize-cpp sanitize-pytest tools wheel wheel-build docs
 
 # Installs the Debian packages that are missing (apt-get update only when needed).
 define apt_install
@@ -151,8 +151,9 @@ python: deps-build venv-demo
 endif
 
 # pytest on PYTEST_WORKERS processes (pytest-xdist), each test file whole on one of them
-# (--dist loadfile: a module's fixtures are computed once and its tests run in their order; the
-# files with the most tests go first). --durations: the slowest tests, for bench/RESULTS.md's
+# (--dist loadfile: a module's fixtures are computed once and its tests run in their order), the
+# files in the order conftest.py gives them (--no-loadscope-reorder): the longest first, by
+# tests/python/file_seconds.txt (make pytest-order writes it anew from a whole run). --durations: the slowest tests, for bench/RESULTS.md's
 # table of the suite. Serial: make pytest PYTEST_WORKERS=0. One file: PYTEST_ARGS=test_fds.py.
 # One BLAS thread per worker (PYTEST_BLAS_THREADS): the workers already fill the cores, and
 # OpenBLAS's threads spinning beside another worker's slow the NumPy reference's dense tests
@@ -163,8 +164,13 @@ PYTEST_BLAS_THREADS ?= 1
 PYTEST_ARGS ?=
 pytest: deps venv python
 	cd tests/python && OPENBLAS_NUM_THREADS=$(PYTEST_BLAS_THREADS) OMP_NUM_THREADS=$(PYTEST_BLAS_THREADS) \
-	  ../../$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile \
+	  ../../$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder \
 	  --durations=20 $(PYTEST_ARGS)
+
+pytest-order: deps venv python
+	cd tests/python && OPENBLAS_NUM_THREADS=$(PYTEST_BLAS_THREADS) OMP_NUM_THREADS=$(PYTEST_BLAS_THREADS) \
+	  ../../$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder \
+	  --durations=0 | tee $(CURDIR)/$(BUILDROOT)/pytest-durations.txt | ../../$(PY) file_seconds.py
 
 # Every benchmark executable (built by make cpp) and script once at small sizes (bench/smoke.py:
 # seconds each); each must exit 0. Outputs in $(BUILDROOT)/bench-smoke/.

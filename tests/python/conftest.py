@@ -482,3 +482,35 @@ REPORT_CHI_LEVEL = 0.999
 # order itself) at the same point. Measured: 5e-11 std units, 1e-13 relative.
 SCALE_VS_KNOWN_STD_UNITS = 1e-6
 SCALE_VS_KNOWN_STD = 1e-8
+
+
+# ------------------------------------------------------------------------- the suite's order
+
+# make pytest runs the files on two workers, each file whole on one (--dist loadfile) in the
+# order collected (--no-loadscope-reorder). The longest files go first (longest-processing-time
+# scheduling: the last file to start is a short one, so the workers end together); the seconds
+# each file took are in file_seconds.txt (written by `make pytest-order`, from a whole run's
+# --durations=0), a file not listed there counting as that table's median.
+def _file_seconds():
+    from pathlib import Path
+
+    table = {}
+    path = Path(__file__).with_name("file_seconds.txt")
+    if path.exists():
+        for line in path.read_text().splitlines():
+            parts = line.split()
+            if len(parts) == 2 and not line.startswith("#"):
+                table[parts[1]] = float(parts[0])
+    return table
+
+
+def pytest_collection_modifyitems(session, config, items):
+    table = _file_seconds()
+    if not table:
+        return
+    median = float(np.median(list(table.values())))
+    first = {}
+    for i, item in enumerate(items):
+        first.setdefault(item.nodeid.split("::")[0], i)
+    items.sort(key=lambda item: (-table.get(item.nodeid.split("::")[0].rsplit("/", 1)[-1], median),
+                                 first[item.nodeid.split("::")[0]]))
