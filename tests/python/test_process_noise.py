@@ -2,6 +2,7 @@
 record against sums written out here, the test for correlated lines (its size on white noise, its
 power on a rig with a disturbance), and fits of that rig simulated by solve_ivp (process_rig.py)
 in open loop and under feedback."""
+import functools
 import warnings
 
 import numpy as np
@@ -365,6 +366,14 @@ def test_inspect_reference_refusals(tmp_path):
         lptv.inspect(path, u="force", y="displacement", reference=r)
 
 
+@functools.lru_cache(maxsize=None)
+def _closed_loop_records(skip):
+    """The closed-loop rig's records of seeds 0..4, 16 periods after ``skip``, integrated in one
+    solve_ivp call (each seed's record is the one rig.records([seed], ...) gives, to the
+    integrator's tolerance)."""
+    return rig.records(range(5), periods=16, loop="feedback", process=5.0, skip=skip)
+
+
 @pytest.mark.parametrize("seed", range(5))
 @pytest.mark.parametrize("skip", [0, 8])
 def test_the_period_of_a_closed_loop_record_from_its_input(seed, skip):
@@ -374,6 +383,6 @@ def test_the_period_of_a_closed_loop_record_from_its_input(seed, skip):
     shows lines off the shorter period's grid above their own noise. (The output's multiple, judged
     on 2 of its periods too, still reads 20 s in 2 of 80 such records, seed 1 from steady state
     among them: not asserted here; METHOD.md section 18.)"""
-    rec = rig.records([seed], periods=16, loop="feedback", process=5.0, skip=skip)[0]
+    rec = _closed_loop_records(skip)[seed]
     r = lptv.inspect(u=rec["u"].ravel(), y=rec["y"].ravel(), fs=rig.FS)
     assert r.input_period_samples == 4 * rig.FS
