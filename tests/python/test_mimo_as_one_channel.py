@@ -168,10 +168,11 @@ FIT = ["--input", "f1,f2", "--output", "x1,x2", "--period", str(T0), "--na", "2"
        "--noise", "sample"]
 
 
-def run(capsys, *argv):
-    """lptv identify without its report (no test here reads report.html; the report's own test
-    below builds it directly)."""
-    rc = cli.main(["identify", *map(str, argv), "--no-report"])
+def run(capsys, *argv, report=False):
+    """lptv identify; without its report unless ``report`` (no test here reads report.html: the
+    runs that keep it are those whose report takes a path of its own, a rejected or undetermined
+    verdict and --scale, so that building it stays exercised)."""
+    rc = cli.main(["identify", *map(str, argv), *([] if report else ["--no-report"])])
     out, err = capsys.readouterr()
     return rc, out, err
 
@@ -236,7 +237,7 @@ def test_scale_gives_the_physical_matrices_as_the_one_channel_scale(periods, fil
     diagonal entry within MIMO_DECOUPLED_SIGMAS of the one-channel --scale b0=1 of that channel
     (lptv.apps.units.scaled, the one-channel route), its interval within MIMO_DECOUPLED_STD_RATIO
     of that one's; the fit and its verdict unchanged."""
-    rc, out, err = run(capsys, *files, *FIT, "--scale", "b0=1", "--out", tmp_path / "o")
+    rc, out, err = run(capsys, *files, *FIT, "--scale", "b0=1", "--out", tmp_path / "o", report=True)
     assert rc == 0, out + err
     assert "parameters in physical form (--scale b0=1" in out
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
@@ -283,12 +284,12 @@ def test_the_verdict_s_words_and_exit_status_are_one_channel_s(periods, files, t
     rc, out, err = run(capsys, *files, *FIT, "--out", tmp_path / "o")
     assert rc == 0 and "verdict: the model is consistent with the noise" in out, out + err
     bad = [a if a != "1,0,0" else "0" for a in FIT]     # k(t) taken as constant
-    rc, out, err = run(capsys, *files, *bad, "--out", tmp_path / "b")
+    rc, out, err = run(capsys, *files, *bad, "--out", tmp_path / "b", report=True)
     assert rc == 3 and "verdict: MODEL ERRORS: the model is rejected: " in out, out + err
     assert json.loads((tmp_path / "b" / "summary.json").read_text())["verdict"].startswith("MODEL ERRORS:")
     clean = [write_csv(tmp_path / f"c{e}.csv", np.tile(u, (P, 1, 1)), np.tile(y, (P, 1, 1)),
                        "time [s],F1 [N],F2 [N],x1 [mm],x2 [V]") for e, (u, y) in enumerate(periods)]
-    rc, out, err = run(capsys, *clean, *FIT, "--out", tmp_path / "c")
+    rc, out, err = run(capsys, *clean, *FIT, "--out", tmp_path / "c", report=True)
     assert rc == 4 and "verdict: NOT DETERMINED: " in out, out + err
     # one channel of the same files says the same words
     rc1, out1, err1 = run(capsys, files[0], *[a if a not in ("f1,f2", "x1,x2") else a[:2] for a in FIT],
