@@ -11,7 +11,7 @@ from scipy import signal
 
 import lptv
 from lptv import _core
-from lptv.estimation.one_record_input_noise import input_noise_operator, stacked
+from lptv.estimation.one_record_input_noise import input_noise_operator, smooth, stacked
 
 RIGHT = dict(na=2, nb=1, ka=[1, 0, 0], kb=[1, 0])
 TRUTH = {"a0.re0": 0.5, "a0.re1": 0.05 * np.cos(0.3), "a0.im1": 0.05 * np.sin(0.3), "a1.re0": -1.2,
@@ -63,15 +63,79 @@ def test_the_input_noise_operator_is_the_prediction_s_response_to_the_noise():
     assert nl == N // 2 - 1
 
 
+def test_the_operator_in_continuous_time():
+    """The same on the continuous-time grid (the signed lines -M..M, not circular): the impulse
+    shifted by whole periods is still the column times exp(-j 2 pi l q / L)."""
+    N0, L = 32, 4
+    N, period = N0 * L, 10.0
+    w0, ts = 2 * np.pi / period, period / N0
+    par = _core.Parametrisation(2, 0, [1, 0, 0], [0], [], w0, 0.0)
+    names = list(par.eta_names)
+    value = {"a0.re0": 4.0, "a0.re1": 0.2, "a0.im1": -0.1, "a1.re0": 0.4, "b0.re0": 1.0}
+    ef = np.array([value[names[i]] for i in par.free_indices])
+    lines = np.arange(1, (N - 1) // 8 + 1)
+    idx = lines + (N - 1) // 2
+    M = input_noise_operator(par, L, ef, ts, 3, idx, lines, N)
+    rng = np.random.default_rng(4)
+    u, n = rng.standard_normal(N), 0.1 * rng.standard_normal(N)
+
+    def pred(x):
+        return np.asarray(_core.record_prediction(par, np.fft.fft(x) / N, L, ef, np.zeros(0), ts, 3))[idx]
+
+    d = pred(u + n) - pred(u)
+    assert np.abs(M @ n - d).max() < 1e-10 * np.abs(d).max()
+
+
+def test_the_input_noise_s_share_of_the_covariance():
+    """One record (its output and output noise fixed), 300 draws of 10 % input noise, each fitted
+    with the same weights (those of one noisy record): the estimates' covariance is the input
+    noise's share of the sandwich, (J^T J)^-1 J^T D s_u^2 M_r M_r^T D J (J^T J)^-1, per parameter
+    within 0.25 in log (measured 0.85-1.04; sampling error of each ratio about 0.08); half of it
+    or twice it fails. (Here the lines' correlation changes little: the diagonal with the
+    smoothed level predicts 0.92-1.04; METHOD.md section 17.)"""
+    from lptv.judgement.one_record_score import score_parts
+
+    u0, y, w0 = discrete_lptv(4)
+    N, L = u0.size, 8
+    su = 0.1 * np.std(u0)
+    rng = np.random.default_rng(12)
+    base = fit(u0 + su * rng.standard_normal(N), y, w0)     # the weights as one noisy record gives them
+    var, lines = base.noise_var, base.lines
+    par = _core.Parametrisation(2, 1, [1, 0, 0], [1, 0], [], w0, 1.0)
+    free = list(par.free_indices)
+    U0, Y = np.fft.fft(u0) / N, np.fft.fft(y) / N
+    fits = []
+    for _ in range(300):
+        Ud = np.fft.fft(u0 + su * rng.standard_normal(N)) / N
+        f = _core.fit_record(par, Ud, Y, L, [int(v) for v in lines], noise_var=var, ts=1.0)
+        fits.append(np.asarray(f.eta)[free])
+    mc = np.var(np.array(fits), axis=0, ddof=1)
+    f0 = _core.fit_record(par, U0, Y, L, [int(v) for v in lines], noise_var=var, ts=1.0)
+    parts = score_parts(2, 1, [1, 0, 0], [1, 0], w0, 1.0, U0, Y[lines] - np.asarray(f0.Y_fit), L, lines,
+                        np.asarray(f0.eta), np.asarray(f0.transient), var, 1.0, -1, False)
+    Mr = stacked(input_noise_operator(par, L, np.asarray(f0.eta)[free], 1.0, -1, lines, lines, N))
+    D = np.sqrt(2.0 / np.concatenate([var, var]))
+    Sin = su ** 2 * (D[:, None] * (Mr @ Mr.T) * D[None, :])
+    B = np.linalg.inv(parts.J.T @ parts.J)
+    nf = len(free)
+    full = np.diag(B @ parts.J.T @ Sin @ parts.J @ B)[:nf]
+    n = lines.size
+    cu = np.diag(Sin)[:n] + np.diag(Sin)[n:]
+    smoothed = np.concatenate([smooth(cu, 10), smooth(cu, 10)]) / 2
+    before = np.diag(B @ parts.J.T @ np.diag(smoothed) @ parts.J @ B)[:nf]
+    assert np.all(np.abs(np.log(mc / full)) < 0.25), mc / full
+    assert np.all(np.abs(np.log(mc / before)) < 0.25), mc / before
+
+
 def test_the_reported_variance_matches_the_monte_carlo_s():
-    """10 % input noise, 40 records: the Monte Carlo variance of eta_corrected over the mean
-    reported std_corrected^2, pooled over the parameters (the mean of its logarithm), is within
-    0.2 of 1 (log 0) with the input noise's covariance, and further from it without (the
-    output-error inverse Fisher information with the refits' spread: measured 0.76 here)."""
-    now, before = [], []
+    """The whole route, 10 % input noise, 30 records: the Monte Carlo variance of eta_corrected
+    over the mean reported std_corrected^2, pooled over the parameters (the mean of its
+    logarithm), is within 0.15 of 1 (log 0) with the input noise's covariance, and further from
+    it with the output-error inverse Fisher information and the refits' spread (the covariance
+    before it; measured 0.00 and 0.13)."""
     truth = np.array(list(TRUTH.values()))
     est, var, var0 = [], [], []
-    for seed in range(40):
+    for seed in range(30):
         u0, y, w0 = discrete_lptv(seed)
         su = 0.1 * np.std(u0)
         u = u0 + su * np.random.default_rng(500 + seed).standard_normal(u0.size)
@@ -85,7 +149,7 @@ def test_the_reported_variance_matches_the_monte_carlo_s():
     mc = np.var(est, axis=0, ddof=1)
     now = np.mean(np.log(mc / var.mean(0)))
     before = np.mean(np.log(mc / var0.mean(0)))
-    assert abs(now) < 0.2, (now, before)
+    assert abs(now) < 0.15, (now, before)
     assert abs(now) < abs(before), (now, before)
 
 

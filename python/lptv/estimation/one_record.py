@@ -51,7 +51,8 @@ class RecordResult:
     """The record's DFT lines fitted (spacing w0 / L)."""
     noise_var: np.ndarray
     """Output noise variance E|V_l|^2 per fitted line (from the residual, the local polynomial
-    method, or given)."""
+    method, or given); with ``input_noise_std`` the weights, that plus the input noise's share of
+    each line."""
     noise_dof: int
     """Lines behind each line's variance: the residual route's average, or the local polynomial
     method's complex degrees of freedom (0 when given)."""
@@ -309,9 +310,13 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         noise-to-signal power ratio); with this the bias is measured to first order by refitting
         with as much noise again added to the input, ``input_noise_draws`` times, and reported
         (``input_noise_bias``, in the warnings in std units) and removed in ``eta_corrected``,
-        whose std ``std_corrected`` is. Measured (bench/HISTORY.md, "One record with a noisy
-        input"): at 5 % input noise the corrected estimates' mean error within 0.15 std (the raw
-        ones' up to 0.55), their 95 % intervals covering 93.4 % pooled (89.5-97 % per parameter).
+        whose std ``std_corrected`` is (``confidence_interval`` gives its intervals). The input
+        noise also adds to each line's residue, through the model's HTF branches, and correlates
+        the lines that share input lines: with this the weights are each line's output noise
+        plus that share, ``covariance`` the sandwich with the residue's full covariance, and the
+        verdict's tests account for it and for the bias (METHOD.md section 17, "A noisy input:
+        the covariance and the verdict"); ``noise_var`` then holds the weights. Measured
+        (bench/HISTORY.md, "One record with a noisy input: the covariance and the verdict").
     input_noise_draws : int
         Refits behind the bias (each one fit's cost).
     seed : int or numpy Generator, optional
