@@ -14,7 +14,10 @@ whose right structure ``model_ok`` rejects (nominal size 1 %), with input_noise_
 without it ("no s_u": the verdict as it was before the input noise entered it), with their
 binomial standard errors, and how many of the rejections came from the score tests.
 
-    python bench/python/bench_record_input_noise.py [runs] [--levels 2 4 6 8 10]
+``--system continuous``: the continuous-time mass-spring system of bench_record_verdict.py
+(solve_ivp, 4 periods of 128 samples, the input a band-limited sum of sinusoids) instead.
+
+    python bench/python/bench_record_input_noise.py [runs] [--levels 2 4 6 8 10] [--system continuous]
 """
 from __future__ import annotations
 
@@ -29,11 +32,19 @@ import numpy as np
 import lptv
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_record_verdict import discrete_lptv  # noqa: E402
+from bench_record_verdict import continuous_lptv, discrete_lptv  # noqa: E402
 
-TRUTH = {"a0.re0": 0.5, "a0.re1": 0.05 * np.cos(0.3), "a0.im1": 0.05 * np.sin(0.3), "a1.re0": -1.2,
-         "a2.re0": 1.0, "b0.re0": 1.0, "b0.re1": 0.05, "b0.im1": 0.0, "b1.re0": 0.5}
-STRUCTURE = dict(na=2, nb=1, ka=[1, 0, 0], kb=[1, 0])
+SYSTEMS = {
+    # the discrete LPTV system of bench_record_verdict.py: 8 periods of 64 samples
+    "discrete": (discrete_lptv,
+                 {"a0.re0": 0.5, "a0.re1": 0.05 * np.cos(0.3), "a0.im1": 0.05 * np.sin(0.3), "a1.re0": -1.2,
+                  "a2.re0": 1.0, "b0.re0": 1.0, "b0.re1": 0.05, "b0.im1": 0.0, "b1.re0": 0.5},
+                 dict(na=2, nb=1, ka=[1, 0, 0], kb=[1, 0])),
+    # its continuous-time mass-spring system (solve_ivp), 4 periods of 128 samples
+    "continuous": (lambda seed: continuous_lptv(seed, L=4),
+                   {"a0.re0": 4.0, "a0.re1": 0.2, "a0.im1": 0.0, "a1.re0": 0.4, "a2.re0": 1.0, "b0.re0": 1.0},
+                   dict(na=2, nb=0, ka=[1, 0, 0], kb=0)),
+}
 
 
 def _rate(flags):
@@ -46,24 +57,25 @@ def _score_rejected(r):
     return any("score test" in e for e in r.model_errors)
 
 
-def main(runs=200, levels=(2, 4, 6, 8, 10)):
-    print(f"One record with a noisy input: {runs} records per level, discrete LPTV system, output noise 1 %")
+def main(runs=200, levels=(2, 4, 6, 8, 10), system="discrete"):
+    make, TRUTH, STRUCTURE = SYSTEMS[system]
+    print(f"One record with a noisy input: {runs} records per level, {system} LPTV system, output noise 1 %")
+    records = [make(seed) for seed in range(runs)]
     summary = []
     for pct in levels:
         rel = pct / 100
         t0 = time.perf_counter()
         raw, cor, ci_in, rej, rej_score, rej0 = [], [], [], [], [], []
         est, var = [], []
-        for seed in range(runs):
-            u0, y, kw = discrete_lptv(seed)
+        for seed, (u0, y, kw) in enumerate(records):
             rng = np.random.default_rng(10_000 + seed)
             su = rel * np.std(u0)
             u = u0 + su * rng.standard_normal(u0.size)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                r = lptv.identify_record(u, y, w0=kw["w0"], ts=1.0, **STRUCTURE, input_noise_std=su,
+                r = lptv.identify_record(u, y, **kw, **STRUCTURE, input_noise_std=su,
                                         seed=1_000_000 + seed)   # not the stream that made the record
-                r0 = lptv.identify_record(u, y, w0=kw["w0"], ts=1.0, **STRUCTURE)
+                r0 = lptv.identify_record(u, y, **kw, **STRUCTURE)
             truth = np.array([TRUTH[n] for n in r.eta_names])
             free = r.parameter_std > 0
             raw.append(((r.eta - truth)[free] / r.parameter_std[free]))
@@ -107,5 +119,6 @@ if __name__ == "__main__":
     ap.add_argument("runs", nargs="?", type=int, default=200)
     ap.add_argument("--levels", nargs="+", type=float, default=[2, 4, 6, 8, 10],
                     help="input noise levels, %% of the input's std")
+    ap.add_argument("--system", choices=sorted(SYSTEMS), default="discrete")
     a = ap.parse_args()
-    main(a.runs, tuple(a.levels))
+    main(a.runs, tuple(a.levels), a.system)

@@ -70,7 +70,9 @@ class RecordResult:
     """Levenberg-Marquardt iterations of the last fit (the residual route fits three times)."""
     record_verdict: Optional[RecordVerdict] = None
     """The cross-correlation test of the residual with the input and its shifts
-    (:mod:`lptv.record_verdict`), which needs no noise level: behind :attr:`model_ok`."""
+    (:mod:`lptv.record_verdict`), which needs no noise level, and the score tests: behind
+    :attr:`model_ok`. With ``input_noise_std`` both take the input noise's covariance and bias
+    into account (METHOD.md section 17)."""
     warnings: Tuple[str, ...] = ()
     """What the fit warned about (also issued as warnings): no convergence, a noise level the
     residual contradicts, the bias a noisy input causes."""
@@ -316,7 +318,12 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
         plus that share, ``covariance`` the sandwich with the residue's full covariance, and the
         verdict's tests account for it and for the bias (METHOD.md section 17, "A noisy input:
         the covariance and the verdict"); ``noise_var`` then holds the weights. Measured
-        (bench/HISTORY.md, "One record with a noisy input: the covariance and the verdict").
+        (bench/HISTORY.md, "One record with a noisy input: the covariance and the verdict"; a
+        discrete LPTV system, 400 records per level): at 2-10 % input noise the corrected 95 %
+        intervals cover 94.6-96.1 % pooled (92.8-98.5 % per parameter), the verdict rejects
+        the right structure in 0-1 % of the records (0.5-28 % without ``input_noise_std``).
+        Its cost: 0.35 s on a record of 512 samples against 0.04 s without (the refits' score
+        and window estimates, the Jacobians by differences).
     input_noise_draws : int
         Refits behind the bias (each one fit's cost).
     seed : int or numpy Generator, optional
