@@ -66,7 +66,7 @@ SMOKE = {
     "bench_record.py": ["--runs", "3", "--periods", "4"],
     "bench_record_core.py": ["1", "4"],
     "bench_record_verdict.py": ["3", "2"],
-    "bench_record_input_noise.py": ["3"],
+    "bench_record_input_noise.py": ["3", "--levels", "4"],
     "bench_report_time.py": ["--runs", "1"],
     "bench_select.py": ["1", "--small"],
     "bench_select_time.py": ["1"],

@@ -24,11 +24,18 @@ class CramerRaoBound:
     eta: np.ndarray
     """The true free real parameters (normalised as :func:`identify` normalises)."""
     eta_names: Tuple[str, ...]
+    """The names of ``eta``'s entries (also as ``parameter_names``)."""
     lines: np.ndarray
     periods: Union[int, Tuple[int, ...]]
     """P (several experiments: one P per experiment)."""
     experiment: Optional[np.ndarray] = None
     """Per row of ``lines``: the index of its experiment (several experiments; None for one)."""
+
+    @property
+    def parameter_names(self) -> Tuple[str, ...]:
+        """The names of ``eta``'s entries: the same tuple as ``eta_names`` (the name
+        :class:`lptv.MimoCramerRaoBound` gives it; either works on either bound)."""
+        return self.eta_names
 
     @property
     def std(self) -> np.ndarray:

@@ -392,6 +392,13 @@ class MimoCramerRaoBound:
     eta: np.ndarray
     """The true parameters, normalised to A_na,0 = I."""
     parameter_names: Tuple[str, ...]
+    """The names of ``eta``'s entries (also as ``eta_names``)."""
+
+    @property
+    def eta_names(self) -> Tuple[str, ...]:
+        """The names of ``eta``'s entries: the same tuple as ``parameter_names`` (the name
+        :class:`lptv.CramerRaoBound` gives it; either works on either bound)."""
+        return self.parameter_names
 
     @property
     def std(self) -> np.ndarray:

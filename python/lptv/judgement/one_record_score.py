@@ -8,7 +8,7 @@ that J_c explains beyond J is the score statistic, judged as F(2, dof - 2) again
 """
 from __future__ import annotations
 
-from typing import List, Tuple
+from typing import List, NamedTuple, Tuple
 
 import numpy as np
 
@@ -39,14 +39,25 @@ def _real(Z, scale):
     return np.concatenate([Z.real, Z.imag], axis=0) * np.concatenate([scale, scale])[:, None]
 
 
-def harmonic_score_tests(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta, c, var, ts, t_degree,
-                         continuous) -> List[Tuple[str, float, int, int, float]]:
-    """(coefficient and harmonic, F, 2, dof - 2, p-value) per coefficient a_0..a_na, b_0..b_nb.
+class ScoreParts(NamedTuple):
+    """What the score tests of one fit are built from (:func:`score_parts`)."""
 
-    ``eta``: the fit's real parameters (all, as ``fit.eta``), ``c`` its transient coefficients,
-    ``residual`` Y - Y_hat on ``lines``, ``var`` the noise variance per line the cost divides by."""
-    from .._dist import f_sf
+    J: np.ndarray
+    """The scaled real Jacobian over the free parameters and the transient's (rows as the cost)."""
+    r: np.ndarray
+    """The scaled real residual (cost = r^T r)."""
+    Q: np.ndarray
+    """An orthonormal basis of J's columns."""
+    dof: int
+    cost: float
+    coefficients: list
+    """(label, harmonic, J_c') per coefficient: J_c' the new harmonic's two columns less their
+    projection on J."""
 
+
+def score_parts(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta, c, var, ts, t_degree,
+                continuous) -> ScoreParts:
+    """The Jacobians and the residual of :func:`harmonic_score_tests` (same arguments)."""
     lines = np.asarray(lines)
     N = U.size
     idx = lines + (N - 1) // 2 if continuous else lines
@@ -64,7 +75,7 @@ def harmonic_score_tests(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta,
     cost = float(r @ r)
     names = list(par.eta_names)
     value = dict(zip(names, np.asarray(eta, float)))
-    out = []
+    coefs = []
     for is_a, n in [(True, n) for n in range(na + 1)] + [(False, m) for m in range(nb + 1)]:
         kae, kbe = list(ka), list(kb)
         if is_a:
@@ -80,6 +91,58 @@ def harmonic_score_tests(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta,
         new = [j for j, i in enumerate(fe) if ne[i] in (f"{label}.re{K}", f"{label}.im{K}")]
         Jc = _real(_columns(pe, U, L, x, c, ts, t_degree, idx, new), scale)
         Jc = Jc - Q @ (Q.T @ Jc)
+        coefs.append((label, K, Jc))
+    return ScoreParts(J, r, Q, dof, cost, coefs)
+
+
+def score_estimates(parts: ScoreParts) -> dict:
+    """Per coefficient's label: the one-step estimate of the new harmonic (Re, Im) from the
+    residual, (J_c'^T J_c')^+ J_c'^T r (what the extended fit would move it to, to first order)."""
+    return {label: np.linalg.pinv(Jc) @ parts.r for label, _, Jc in parts.coefficients}
+
+
+def harmonic_score_tests(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta, c, var, ts, t_degree,
+                         continuous, *, parts=None, sigma=None, draws=()) -> List[Tuple[str, float, int, int, float]]:
+    """(coefficient and harmonic, F, 2, dof - 2, p-value) per coefficient a_0..a_na, b_0..b_nb.
+
+    ``eta``: the fit's real parameters (all, as ``fit.eta``), ``c`` its transient coefficients,
+    ``residual`` Y - Y_hat on ``lines``, ``var`` the noise variance per line the cost divides by;
+    ``parts``: :func:`score_parts` of these, when already made.
+
+    With a noisy input (METHOD.md section 17, "A noisy input: the covariance and the verdict"):
+    ``sigma`` the scaled residual's covariance (real rows as the cost's, the input noise's
+    share included) and ``draws`` the :func:`score_estimates` of the refits with more noise
+    added to the input. The test is then the Wald form of the score: the one-step estimate d of
+    the new harmonic less the refits' mean shift (the bias the input noise causes), against its
+    covariance G^-1 J_c'^T sigma J_c' G^-1 (G = J_c'^T J_c') plus the shifts' covariance over the
+    draws; d^T V^-1 d / rank over the residual's scale r^T r / tr((I - P_J) sigma) is F(rank,
+    dof - rank)."""
+    from .._dist import f_sf
+
+    if parts is None:
+        parts = score_parts(na, nb, ka, kb, w0, ts_par, U, residual, L, lines, eta, c, var, ts, t_degree,
+                            continuous)
+    r, Q, dof, cost = parts.r, parts.Q, parts.dof, parts.cost
+    out = []
+    if sigma is not None:
+        level = cost / max(float(np.trace(sigma)) - float(np.sum(Q * (sigma @ Q))), 1e-300)
+    for label, K, Jc in parts.coefficients:
+        if sigma is not None:
+            Jp = np.linalg.pinv(Jc)
+            rank = int(np.linalg.matrix_rank(Jc, tol=1e-8 * max(np.linalg.norm(Jc), 1e-300)))
+            if rank == 0 or dof - rank <= 0:
+                continue
+            d = Jp @ r
+            V = Jp @ sigma @ Jp.T
+            if len(draws):
+                shifts = np.array([e[label] for e in draws]) - d
+                d = d - shifts.mean(axis=0)
+                if len(draws) > 1:
+                    V = V + np.cov(shifts, rowvar=False, ddof=1).reshape(V.shape) / len(draws)
+            T = float(d @ np.linalg.pinv(V, hermitian=True) @ d)
+            F = (T / rank) / level
+            out.append((f"{label} harmonic {K}", float(F), rank, int(dof - rank), float(f_sf(F, rank, dof - rank))))
+            continue
         Qc, Rc = np.linalg.qr(Jc)
         rank = int(np.sum(np.abs(np.diag(Rc)) > 1e-8 * max(np.linalg.norm(Jc), 1e-300)))
         if rank == 0 or dof - rank <= 0:

@@ -113,6 +113,100 @@ def record_verdict(U, residual, lines, L, kmax, alpha: float = ALPHA, scores=())
     p = float(f_sf(F, d_expl, d_rest))
     per = [float(f_sf((drop[j] / (2 * seen[j])) / (s_rest / d_rest), 2 * seen[j], d_rest)) if seen[j] else np.nan
            for j in range(q)]
+    return _holm_verdict(F, (d_expl, d_rest), p, shifts, per, W, alpha, scores)
+
+
+INPUT_NSR_MAX = 0.02
+"""With a noisy input: a regressor column enters a window's test only where the input's noise is at
+most this share of its power there (its mean over the window's lines, the noise's known
+s_u^2 / N per line taken off): where the noise dominates, the column is the noise itself, which
+the residual holds through the model's gain, and the refits' doubling of it is no longer linear."""
+
+
+def window_estimates(U, residual, lines, L, kmax):
+    """Per window of :func:`record_verdict`: the least-squares coefficients of the normalised
+    residual on the input and its shifts (all columns), for the refits of a noisy input."""
+    N = U.size
+    lines = np.asarray(lines)
+    e = np.asarray(residual, dtype=complex)
+    shifts = tuple(range(-(kmax + 1), kmax + 2))
+    X = np.stack([U[(lines - k * L) % N] for k in shifts], axis=1)
+    W = _window(len(shifts))
+    return [np.linalg.lstsq(X[w * W:(w + 1) * W], e[w * W:(w + 1) * W], rcond=1e-10)[0]
+            for w in range(lines.size // W)]
+
+
+def noisy_input_verdict(U, residual, lines, L, kmax, *, sigma, level, dof, noise_power, draws,
+                        alpha: float = ALPHA, scores=()) -> RecordVerdict:
+    """The windowed test of :func:`record_verdict` with a noisy input of known level (METHOD.md
+    section 17, "A noisy input: the covariance and the verdict"): per window the coefficients b
+    of the normalised residual on the input and its shifts, less the refits' mean shift
+    (``draws``: :func:`window_estimates` of each refit, fitted on the input with more noise
+    added), against their covariance A sigma_w A^T (A the real least-squares operator, sigma_w
+    the residual's covariance on the window's lines, the input noise's share included) plus the
+    shifts' over the draws; the Wald statistics summed over the windows, over the residual's
+    ``level``, are F(d1, dof). A column enters only where the input's noise-to-signal power
+    (``noise_power`` = s_u^2 / N per line) is at most INPUT_NSR_MAX. ``sigma``: the covariance
+    of the normalised residual's real rows (Re of all lines, then Im)."""
+    from .._dist import f_sf
+
+    N = U.size
+    lines = np.asarray(lines)
+    n = lines.size
+    e = np.asarray(residual, dtype=complex)
+    shifts = tuple(range(-(kmax + 1), kmax + 2))
+    X = np.stack([U[(lines - k * L) % N] for k in shifts], axis=1)
+    q = len(shifts)
+    W = _window(q)
+    n_win = n // W
+    T = 0.0
+    d1 = 0
+    per_T, per_d = np.zeros(q), np.zeros(q, int)
+    for w in range(n_win):
+        rows = np.arange(w * W, (w + 1) * W)
+        Xw, ew = X[rows], e[rows]
+        power = np.mean(np.abs(Xw) ** 2, axis=0)
+        keep = (power - noise_power) > noise_power / INPUT_NSR_MAX
+        if not keep.any():
+            continue
+        A = np.linalg.pinv(Xw[:, keep], rcond=1e-10)
+        rank = int(np.linalg.matrix_rank(Xw[:, keep]))
+        if rank == 0 or rank >= W:
+            continue
+        b = A @ ew
+        Ar = np.block([[A.real, -A.imag], [A.imag, A.real]])
+        ridx = np.concatenate([rows, n + rows])
+        V = Ar @ sigma[np.ix_(ridx, ridx)] @ Ar.T
+        br = np.concatenate([b.real, b.imag])
+        if len(draws):
+            d = np.array([np.concatenate([dk[w][keep].real, dk[w][keep].imag]) for dk in draws]) - br
+            br = br - d.mean(axis=0)
+            if len(draws) > 1:
+                V = V + np.cov(d, rowvar=False, ddof=1).reshape(V.shape) / len(draws)
+        T += float(br @ np.linalg.pinv(V, hermitian=True) @ br)
+        d1 += 2 * rank
+        m = int(keep.sum())
+        for j, col in enumerate(np.flatnonzero(keep)):
+            sub = [j, m + j]
+            T_j = float(br[sub] @ np.linalg.pinv(V[np.ix_(sub, sub)], hermitian=True) @ br[sub])
+            per_T[col] += T_j
+            per_d[col] += 2
+    scores = tuple(scores)
+    if d1 == 0 or dof <= 0:
+        return RecordVerdict(np.nan, (d1, dof), np.nan, shifts, tuple([np.nan] * q), W, alpha,
+                             ("the verdict needs at least one window of "
+                              f"{W} lines where the input stands above its noise",), scores)
+    F = (T / d1) / level
+    p = float(f_sf(F, d1, dof))
+    per = [float(f_sf((per_T[j] / per_d[j]) / level, int(per_d[j]), dof)) if per_d[j] else np.nan for j in range(q)]
+    return _holm_verdict(F, (d1, dof), p, shifts, per, W, alpha, scores)
+
+
+def _holm_verdict(F, dofs, p, shifts, per, W, alpha, scores) -> RecordVerdict:
+    """Holm's method over the windowed test's pooled p-value and the score tests, and the names
+    of what the rejected ones point to."""
+    d_expl, d_rest = dofs
+    q = len(shifts)
     # Holm over the windowed test and the score tests: the smallest p against alpha / m, ...
     ps = [p] + [t[4] for t in scores]
     m = len(ps)
