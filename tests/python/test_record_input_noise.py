@@ -199,3 +199,19 @@ def test_the_bounds_name_their_parameters_both_ways():
     U = lptv.multisine(range(1, 40), 128, seed=0).spectrum[:, None]
     mb = lptv.mimo_crb(mm, U, noise=[1e-6, 1e-6, 1e-8], periods=8)
     assert mb.eta_names == mb.parameter_names and len(mb.eta_names) == mb.eta.size
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_an_input_noise_level_the_record_cannot_hold_is_said(seed):
+    """A stated input_noise_std ten times the true one (5 % of the input's std) gives far more
+    residual through the model than the record has: the result says so, naming the argument; the
+    true level does not (INPUT_NOISE_EXCESS, measured in its docstring)."""
+    u0, y, w0 = discrete_lptv(seed)
+    rng = np.random.default_rng(100 + seed)
+    su = 0.05 * np.std(u0)
+    u = u0 + su * rng.standard_normal(u0.size)
+    right = fit(u, y, w0, input_noise_std=su, seed=seed)
+    assert not any("more input noise than this record holds" in w for w in right.warnings), right.warnings
+    wrong = fit(u, y, w0, input_noise_std=10 * su, seed=seed)
+    said = [w for w in wrong.warnings if "more input noise than this record holds" in w]
+    assert len(said) == 1 and said[0].startswith("identify_record: input_noise_std = "), wrong.warnings

@@ -22,8 +22,20 @@ from .. import _core
 from .._validate import as_counts, as_int, as_positive_float, as_real_1d, as_seed
 from ..model.siso import Model
 from ..judgement.one_record_score import harmonic_score_tests, score_estimates, score_parts
-from .one_record_input_noise import input_noise_operator, residue_covariance, sandwich, split_noise, stacked
+from .one_record_input_noise import input_noise_operator, residue_covariance, sandwich, smooth, split_noise, stacked
 from ..judgement.one_record_verdict import RecordVerdict, noisy_input_verdict, record_verdict, window_estimates
+
+
+INPUT_NOISE_EXCESS = 8.0
+"""``identify_record`` warns when the stated ``input_noise_std`` alone, through the fitted model,
+would give more than this many times the residual the fit leaves on the lines where it is
+largest (the 99th percentile over the lines of the ratio of the two levels, each averaged over
+2 noise_width + 1 lines): a level the record cannot hold, such as a std in the wrong units.
+Measured on the two systems of bench/python/bench_record_input_noise.py (15 records each at 2
+and 10 % input noise): the right level gives 1.2-3.6 (the input noise can be all of a line's
+residual, and the fit's leverage lowers the residual near the resonance), twice the right std
+4.8-14 (a factor 4 in variance, not always told), so only a level about three times the right
+std or more is flagged."""
 
 
 @dataclass(frozen=True)
@@ -437,12 +449,16 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
     free = list(par.free_indices)
     ts_par = 0.0 if continuous else float(ts)
     idx = lines + (N - 1) // 2 if continuous else lines
-    sigma = None
+    sigma = excess = None
     if input_noise_std is not None:
         # the input noise's share of each line's residue (METHOD.md section 17, "A noisy input: the
         # covariance and the verdict"): into the weights, then the sandwich covariance
         M = input_noise_operator(par, L, np.asarray(fit.eta)[free], float(ts), t_degree, idx, lines, N)
         out_var, cu = split_noise(var, stacked(M), input_noise_std, noise_width, isinstance(noise, str))
+        if isinstance(noise, str):
+            # the stated input noise alone, through the model, against the residual's own level:
+            # well above 1 it is more noise than the record's residual holds
+            excess = float(np.quantile(smooth(cu, noise_width) / var, 0.99))
         var = out_var + cu
         fit = _core.fit_record(par, U, Y, L, line_list, noise_var=var, **fit_args)
         Mr = stacked(input_noise_operator(par, L, np.asarray(fit.eta)[free], float(ts), t_degree, idx, lines, N))
@@ -507,6 +523,11 @@ def identify_record(u, y, *, na: int, nb: int, ka=0, kb=0, w0: float, ts: float,
             said.append(f"identify_record: the local polynomial method's noise level is {1 / ratio:.3g} times "
                         "what the fit's residual shows: it overestimates the noise where the HTF's branches "
                         "decay slowly (raise lpm_branches), and weighs the lines wrongly; use noise='residual'")
+    if excess is not None and excess > INPUT_NOISE_EXCESS:
+        said.append(f"identify_record: input_noise_std = {input_noise_std:.3g} is more input noise than this record "
+                    f"holds: through the model it alone would give {excess:.3g} times the residual the fit leaves "
+                    "(the 99th percentile over the lines); the estimates and intervals rest on it. Give the std of the input "
+                    "sensor's noise in the input's own units (a record at rest measures it)")
     if input_noise_std is not None:
         std = np.sqrt(np.diag(cov_eta))
         isfree = std > 0
